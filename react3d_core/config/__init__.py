@@ -1,0 +1,89 @@
+"""The one pipeline config: every threshold with the paper's default and what it does.
+
+Load from JSON/YAML-like dicts with ``PipelineConfig.model_validate(d)``; a run records
+``config.model_dump(mode="json")`` in its manifest.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from pydantic import Field, ValidationError
+
+from ..errors import ConfigError
+from ._base import StageConfig
+from .articulation import ArticulationConfig, AssemblyConfig, CavityConfig, DedupConfig, LimitConfig
+from .evaluation import EvaluationConfig
+from .export import ExportConfig
+from .frames import FrameSelectionConfig
+from .perception import OracleNoiseConfig, PerceptionConfig
+from .segmentation import ClipConfig, FusionConfig, TopKConfig
+
+
+class PipelineConfig(StageConfig):
+    """All stages' settings."""
+
+    frames: FrameSelectionConfig = Field(default_factory=FrameSelectionConfig)
+    perception: PerceptionConfig = Field(default_factory=PerceptionConfig)
+    fusion: FusionConfig = Field(default_factory=FusionConfig)
+    topk: TopKConfig = Field(default_factory=TopKConfig)
+    clip: ClipConfig = Field(default_factory=ClipConfig)
+    articulation: ArticulationConfig = Field(default_factory=ArticulationConfig)
+    limits: LimitConfig = Field(default_factory=LimitConfig)
+    cavity: CavityConfig = Field(default_factory=CavityConfig)
+    dedup: DedupConfig = Field(default_factory=DedupConfig)
+    assembly: AssemblyConfig = Field(default_factory=AssemblyConfig)
+    export: ExportConfig = Field(default_factory=ExportConfig)
+    evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)
+
+    def with_overrides(self, overrides: dict) -> "PipelineConfig":
+        """Return a copy with nested overrides, e.g. ``{"perception": {"backend": "oracle"}}``."""
+        data = self.model_dump()
+        _deep_update(data, overrides)
+        try:
+            return PipelineConfig.model_validate(data)
+        except ValidationError as exc:
+            raise ConfigError(f"invalid config override: {exc}") from None
+
+    @classmethod
+    def from_file(cls, path: str | Path) -> "PipelineConfig":
+        """Read a JSON config file (partial: missing keys keep their defaults)."""
+        path = Path(path)
+        try:
+            data = json.loads(path.read_text())
+        except FileNotFoundError:
+            raise ConfigError(f"{path}: config file not found") from None
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"{path}: not valid JSON ({exc})") from None
+        try:
+            return cls.model_validate(data)
+        except ValidationError as exc:
+            raise ConfigError(f"{path}: invalid config: {exc}") from None
+
+
+def _deep_update(base: dict, upd: dict) -> None:
+    for k, v in upd.items():
+        if isinstance(v, dict) and isinstance(base.get(k), dict):
+            _deep_update(base[k], v)
+        else:
+            base[k] = v
+
+
+__all__ = [
+    "ArticulationConfig",
+    "AssemblyConfig",
+    "CavityConfig",
+    "ClipConfig",
+    "DedupConfig",
+    "EvaluationConfig",
+    "ExportConfig",
+    "FrameSelectionConfig",
+    "FusionConfig",
+    "LimitConfig",
+    "OracleNoiseConfig",
+    "PerceptionConfig",
+    "PipelineConfig",
+    "StageConfig",
+    "TopKConfig",
+]

@@ -1,0 +1,49 @@
+"""Candidate validation, refinement, motion limits, cavity, dedup and assembly thresholds."""
+
+from pydantic import Field
+
+from ._base import StageConfig
+
+
+class ArticulationConfig(StageConfig):
+    """Validation of candidates against the articulation predictor, and refinement (paper eqs.)."""
+
+    valid_iou: float = Field(0.6, ge=0, le=1, description="Candidate valid if predictor mask IoU >= this in a top-k view.")
+    refine: bool = Field(True, description="Snap axes/origins to the part's OBB (off for the ablation).")
+    flat_ratio: float = Field(0.5, gt=0, le=1, description="Refine only flat parts: shortest OBB side < ratio x second.")
+
+
+class LimitConfig(StageConfig):
+    """Motion limits (the paper leaves them open)."""
+
+    revolute_max_deg: float = Field(110.0, gt=0, le=180, description="Cap on revolute opening angle.")
+    revolute_step_deg: float = Field(5.0, gt=0, description="Sweep step when searching the collision-free opening.")
+    collision_clearance_m: float = Field(0.01, ge=0, description="Clearance kept from background/neighbours in the sweep.")
+    prismatic_margin_m: float = Field(0.02, ge=0, description="Prismatic limit = cavity depth - margin.")
+    prismatic_min_m: float = Field(0.05, ge=0, description="Smallest prismatic travel written.")
+
+
+class CavityConfig(StageConfig):
+    """Hidden geometry behind a movable part (d_in = min(d_image, d_hit, d_mesh))."""
+
+    ignore_hits_thickness_factor: float = Field(2.0, ge=0, description="Ignore scene hits closer than this x part thickness.")
+    search_radius_factor: float = Field(0.1, ge=0, description="Probe radius = factor x longest OBB edge.")
+    wall_factor: float = Field(0.03, gt=0, description="Wall thickness = factor x shortest front edge.")
+    min_wall_m: float = Field(0.008, gt=0, description="Minimum wall thickness (m).")
+    default_depth_m: float = Field(0.5, gt=0, description="Depth used when no bound is available.")
+    max_depth_m: float = Field(1.2, gt=0, description="Upper clamp on cavity depth.")
+
+
+class DedupConfig(StageConfig):
+    """Two-stage duplicate removal."""
+
+    tau_dup: float = Field(0.5, ge=0, le=1, description="Stage 1: pairwise IoU >= this -> keep the larger part.")
+    tau_low: float = Field(0.2, ge=0, le=1, description="Stage 2: smaller parts with IoU >= this are cover candidates.")
+    cover_iou: float = Field(0.8, ge=0, le=1, description="Stage 2: remove a part whose candidates' union reaches this IoU.")
+    max_candidates: int = Field(16, ge=1, description="Stage 2 bound: consider at most this many candidates per part.")
+
+
+class AssemblyConfig(StageConfig):
+    """Carving the background."""
+
+    obb_margin_m: float = Field(0.005, ge=0, description="Grow part OBBs by this before deleting background vertices.")

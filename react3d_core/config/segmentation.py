@@ -1,0 +1,38 @@
+"""2D->3D fusion, top-k views, re-segmentation and movable-part clipping."""
+
+from pydantic import Field
+
+from ._base import StageConfig
+
+
+class FusionConfig(StageConfig):
+    """Multi-view 2D->3D fusion through a face co-occurrence graph and Louvain communities."""
+
+    erode_px: int = Field(4, ge=0, description="Erode each mask by this many px before collecting faces (boundary bleed).")
+    min_cooccurrence: int = Field(3, ge=1, description="Edge in the face graph if a face pair co-occurs in >= this many masks.")
+    max_pairs_per_mask: int = Field(20000, ge=1, description="Cap on sampled face pairs per mask (keeps cost linear).")
+    resolutions: tuple[float, ...] = Field((0.5, 1.0, 5.0, 50.0, 500.0), description="Louvain resolutions swept.")
+    min_community_faces: int = Field(10, ge=1, description="Keep communities with more faces than this.")
+    decimate_faces: int | None = Field(80000, description="Fuse on a mesh decimated to this many faces (None: full mesh).")
+    seed: int = Field(0, description="Seed for pair sampling and Louvain.")
+
+
+class TopKConfig(StageConfig):
+    """Choice of the best views per 3D proposal (occlusion-aware silhouettes)."""
+
+    k: int = Field(5, ge=1, description="Number of views kept per proposal.")
+    min_iou: float = Field(0.5, ge=0, le=1, description="A view counts if mask IoU with the rendered proposal > this.")
+    good_iou: float = Field(0.8, ge=0, le=1, description="IoU of a 'good' view.")
+    border_px: int = Field(20, ge=0, description="Skip masks touching the image border within this many px.")
+    min_mask_px: int = Field(100, ge=0, description="Skip masks smaller than this.")
+
+
+class ClipConfig(StageConfig):
+    """RANSAC plane clipping of whole-object meshes to the movable slab (handles kept)."""
+
+    enabled: bool = Field(True, description="Clip segmented meshes to the front plane.")
+    ransac_threshold_m: float = Field(0.02, gt=0, description="RANSAC inlier distance (m).")
+    ransac_iterations: int = Field(1000, ge=1, description="RANSAC iterations.")
+    max_abs_nz: float = Field(0.7071, ge=0, le=1, description="Near-vertical points: |n_z| <= sin 45 deg.")
+    keep_behind_m: float = Field(0.03, ge=0, description="Keep geometry up to this far behind the plane (slab thickness).")
+    seed: int = Field(0, description="RANSAC seed.")

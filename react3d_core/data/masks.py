@@ -1,0 +1,92 @@
+"""2D masks and per-view articulation predictions; arrays stored as bit-packed compressed npz."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field
+
+from ..atomic import read_npz, write_npz
+from ..errors import InputError
+
+
+class Mask2D(BaseModel):
+    """A binary mask on one frame (at the frame's RGB resolution), with its label and score."""
+
+    model_config = ConfigDict(arbitrary_types_allowed=True)
+
+    frame_id: str
+    label: str = "openable"
+    score: float = 1.0
+    mask: np.ndarray = Field(repr=False, description="bool HxW")
+    box: tuple[float, float, float, float] | None = Field(None, description="x0, y0, x1, y1 (px)")
+
+    @property
+    def area(self) -> int:
+        return int(self.mask.sum())
+
+
+class ArticulationPrediction(BaseModel):
+    """One articulated-part prediction on one view, in that view's camera frame (OpenCV axes).
+
+    This is what OPDMulti gives: a part mask, a joint type, an axis and an origin. The origin may
+    come as a 3D camera-frame point or only as a pixel (then depth lifts it, see the articulation stage).
+    """
+
+    model_config = ConfigDict(arbitrary_types_allowed=True)
+
+    frame_id: str
+    mask: np.ndarray = Field(repr=False, description="bool HxW at the frame's RGB resolution")
+    joint_type: Literal["revolute", "prismatic"]
+    axis_cam: tuple[float, float, float]
+    origin_cam: tuple[float, float, float] | None = None
+    origin_px: tuple[float, float] | None = None
+    score: float = 1.0
+
+
+def save_masks(path: str | Path, masks: Sequence[Mask2D]) -> Path:
+    """Write masks to one compressed npz (bit-packed), metadata as arrays (no pickles)."""
+    if masks:
+        h, w = masks[0].mask.shape
+        if any(m.mask.shape != (h, w) for m in masks):
+            raise ValueError("all masks in one file must share a shape")
+        bits = np.stack([np.packbits(m.mask.astype(bool).ravel()) for m in masks])
+    else:
+        h = w = 0
+        bits = np.zeros((0, 0), np.uint8)
+    boxes = np.array([m.box if m.box is not None else (np.nan,) * 4 for m in masks], dtype=float).reshape(-1, 4)
+    return write_npz(
+        path,
+        bits=bits,
+        shape=np.array([h, w]),
+        frame_id=np.array([m.frame_id for m in masks], dtype=str),
+        label=np.array([m.label for m in masks], dtype=str),
+        score=np.array([m.score for m in masks], dtype=float),
+        box=boxes,
+    )
+
+
+def load_masks(path: str | Path) -> list[Mask2D]:
+    """Read masks written by :func:`save_masks`."""
+    z = read_npz(path)
+    try:
+        h, w = (int(x) for x in z["shape"])
+        out = []
+        for i in range(len(z["frame_id"])):
+            m = np.unpackbits(z["bits"][i], count=h * w).astype(bool).reshape(h, w)
+            box = z["box"][i]
+            out.append(
+                Mask2D(
+                    frame_id=str(z["frame_id"][i]),
+                    label=str(z["label"][i]),
+                    score=float(z["score"][i]),
+                    mask=m,
+                    box=None if np.isnan(box).any() else tuple(float(b) for b in box),
+                )
+            )
+        return out
+    except KeyError as exc:
+        raise InputError(path, f"mask archive lacks field {exc}") from None

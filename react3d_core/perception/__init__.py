@@ -1,0 +1,19 @@
+"""Perception interfaces (model calls behind small protocols) and the weight-free backends."""
+
+from .interfaces import (
+    ArticulationPredictor,
+    Perception,
+    PointPromptSegmenter,
+    Tagger,
+    TagFilter,
+    TextPromptSegmenter,
+)
+
+__all__ = [
+    "ArticulationPredictor",
+    "Perception",
+    "PointPromptSegmenter",
+    "TagFilter",
+    "Tagger",
+    "TextPromptSegmenter",
+]

@@ -1,0 +1,22 @@
+#!/usr/bin/env bash
+# Installs everything REACT3D needs on a fresh Debian/Ubuntu machine with Python 3.11 (idempotent).
+# Usage: bash scripts/setup.sh [extras]   e.g. bash scripts/setup.sh test
+set -euo pipefail
+cd "$(dirname "$0")/.."
+extras="${1:-}"
+SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+need_apt=""
+for lib in libusb-1.0.so.0 libgomp.so.1; do
+  ldconfig -p 2>/dev/null | grep -q "$lib" || need_apt=1
+done
+if [ -n "$need_apt" ] && command -v apt-get >/dev/null; then
+  echo "[setup] installing system libraries (libusb-1.0-0, libgomp1) ..."
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq libusb-1.0-0 libgomp1 >/dev/null
+fi
+PY="${PYTHON:-python3}"
+"$PY" -c 'import sys; assert sys.version_info[:2] == (3, 11), f"REACT3D needs Python 3.11, found {sys.version.split()[0]}"'
+spec="."
+[ -n "$extras" ] && spec=".[${extras}]"
+echo "[setup] pip install -e '${spec}' (CPU torch) ..."
+"$PY" -m pip install -q --disable-pip-version-check -e "$spec"
