@@ -1,5 +1,6 @@
 """Perception interfaces (model calls behind small protocols) and the weight-free backends."""
 
+from .factory import make_perception
 from .interfaces import (
     ArticulationPredictor,
     Perception,
@@ -16,4 +17,5 @@ __all__ = [
     "TagFilter",
     "Tagger",
     "TextPromptSegmenter",
+    "make_perception",
 ]
