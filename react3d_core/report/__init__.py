@@ -1,0 +1,8 @@
+"""Looking at a converted scene: a self-contained HTML viewer/report with a slider per joint."""
+
+from .html import build_viewer_html, write_report
+from .payload import scene_payload
+
+STAGE_VERSION = "1"
+
+__all__ = ["STAGE_VERSION", "build_viewer_html", "scene_payload", "write_report"]

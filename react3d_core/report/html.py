@@ -1,0 +1,161 @@
+"""Self-contained HTML: the WebGL viewer (sliders per joint) plus the report tables, in one file.
+
+No CDN, no server: the viewer script and the scene data are inlined, so the report can be mailed or
+opened from a remote box's shared folder. ``react3d view`` serves the same page.
+"""
+
+from __future__ import annotations
+
+import html
+import json
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..atomic import write_text
+from ..data.frames import SceneInput
+from ..data.mesh import load_mesh
+from ..data.parts import InteractiveScene, load_vertex_ids
+from .payload import scene_payload
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,sans-serif;margin:0;color:#222;background:#fafafa}
+header{padding:10px 16px;background:#1f2937;color:#fff}header h1{font-size:18px;margin:0}
+#r3d-app{display:flex;height:72vh;min-height:420px;border-bottom:1px solid #ddd}
+#r3d-stage{position:relative;flex:1}#r3d-canvas{width:100%;height:100%;display:block}
+#r3d-labels{position:absolute;left:0;top:0;pointer-events:none}
+.r3d-label{position:absolute;transform:translate(-50%,-50%);font-size:11px;background:rgba(255,255,255,.8);padding:0 3px;border-radius:3px}
+#r3d-side{width:320px;overflow:auto;padding:8px 10px;background:#fff;border-left:1px solid #ddd;font-size:13px}
+.r3d-row{display:flex;align-items:center;gap:6px;margin:3px 0}.r3d-row input{flex:1}
+.r3d-name{font-size:12px;min-width:92px;text-align:left;border:1px solid #ccc;background:#f3f4f6;border-radius:4px;cursor:pointer}
+#r3d-info{margin-top:8px;padding:6px;background:#f3f4f6;border-radius:4px;line-height:1.45}
+.r3d-thumb{height:80px;margin:4px 4px 0 0;border:1px solid #ccc}
+main{padding:8px 16px}table{border-collapse:collapse;font-size:13px;margin:6px 0 16px}
+td,th{border:1px solid #ddd;padding:3px 8px;text-align:left;vertical-align:middle}th{background:#f3f4f6}
+td img{height:72px;margin-right:3px}
+"""
+
+_APP = """
+<div id="r3d-app">
+  <div id="r3d-stage"><canvas id="r3d-canvas"></canvas><div id="r3d-labels"></div></div>
+  <div id="r3d-side">
+    <div><button id="r3d-open">open all</button> <button id="r3d-close">close all</button></div>
+    <div style="margin:6px 0">
+      <label><input type="checkbox" id="r3d-show-background">background</label>
+      <label><input type="checkbox" id="r3d-show-cavities">cavities</label>
+      <label><input type="checkbox" id="r3d-show-axes">joint axes</label>
+      <label><input type="checkbox" id="r3d-show-labels">labels</label>
+    </div>
+    <div id="r3d-joints"></div>
+    <div id="r3d-info"></div>
+    <div id="r3d-status" style="color:#666;margin-top:6px"></div>
+  </div>
+</div>
+"""
+
+
+def _viewer_js() -> str:
+    return resources.files("react3d_core.report").joinpath("assets/viewer.js").read_text(encoding="utf-8")
+
+
+def _json_for_script(obj: Any) -> str:
+    # '</' would end the <script> element early.
+    return json.dumps(obj, separators=(",", ":")).replace("</", "<\\/")
+
+
+def build_viewer_html(payload: dict[str, Any], title: str, body: str = "", thumbs: dict[str, list[str]] | None = None) -> str:
+    """One HTML page: viewer + optional extra body (tables)."""
+    return (
+        "<!doctype html><html><head><meta charset='utf-8'>"
+        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
+        f"<header><h1>{html.escape(title)}</h1></header>{_APP}<main>{body}</main>"
+        f"<script>window.REACT3D_SCENE={_json_for_script(payload)};"
+        f"window.REACT3D_THUMBS={_json_for_script(thumbs or {})};</script>"
+        f"<script>{_viewer_js()}</script></body></html>"
+    )
+
+
+def _fmt(x: Any, d: int = 3) -> str:
+    if x is None:
+        return "–"
+    if isinstance(x, float):
+        return f"{x:.{d}f}"
+    return html.escape(str(x))
+
+
+def _parts_table(scene: InteractiveScene, thumbs: dict[str, list[str]]) -> str:
+    rows = []
+    for o in scene.objects:
+        a = o.articulation
+        if a.joint_type == "revolute":
+            lim = f"{np.degrees(a.lower):.0f}° … {np.degrees(a.upper):.0f}°"
+        else:
+            lim = f"{a.lower:.3f} … {a.upper:.3f} m"
+        imgs = "".join(f"<img src='{t}'>" for t in thumbs.get(o.object_id, []))
+        views = ", ".join(f"{v.get('frame_id')} ({v.get('iou', 0):.2f})" for v in o.top_views[:5])
+        rows.append(
+            f"<tr><td>{html.escape(o.object_id)}</td><td>{html.escape(o.label)}</td><td>{a.joint_type}</td>"
+            f"<td>{lim}<br><small>{html.escape(a.limit_source)}</small></td><td>{_fmt(o.score, 2)}</td>"
+            f"<td>{_fmt(o.cavity_depth)} m<br><small>{_fmt(o.cavity_depth_source)}</small></td>"
+            f"<td>{imgs or '–'}<br><small>{html.escape(views)}</small></td></tr>"
+        )
+    head = "<tr><th>object</th><th>label</th><th>joint</th><th>limits</th><th>score</th><th>cavity</th><th>top views</th></tr>"
+    return f"<h2>Parts ({len(scene.objects)})</h2><table>{head}{''.join(rows)}</table>"
+
+
+def _metrics_table(metrics: dict[str, Any]) -> str:
+    keys = ["precision", "recall", "f1", "joint_acc", "oe", "md", "pdet", "m", "mo", "mod"]
+    rows = []
+    for tau, vals in metrics.items():
+        if not isinstance(vals, dict):
+            continue
+        rows.append(f"<tr><td>{html.escape(str(tau))}</td>" + "".join(f"<td>{_fmt(vals.get(k))}</td>" for k in keys) + "</tr>")
+    if not rows:
+        return ""
+    head = "<tr><th>IoU τ</th>" + "".join(f"<th>{k}</th>" for k in keys) + "</tr>"
+    return f"<h2>Metrics against ground truth</h2><table>{head}{''.join(rows)}</table>"
+
+
+def _timings_table(timings: dict[str, float]) -> str:
+    if not timings:
+        return ""
+    rows = "".join(f"<tr><td>{html.escape(k)}</td><td>{v:.2f}</td></tr>" for k, v in timings.items())
+    return f"<h2>Timings (s)</h2><table><tr><th>stage</th><th>seconds</th></tr>{rows}</table>"
+
+
+def write_report(
+    manifest_path: str | Path,
+    out_path: str | Path | None = None,
+    scene_input: SceneInput | None = None,
+    metrics: dict[str, Any] | None = None,
+    thumbnails: bool = True,
+) -> Path:
+    """Write ``report.html`` next to the manifest: viewer, parts with thumbnails, metrics, timings.
+
+    ``metrics`` is the per-threshold dict (``{"0.25": {...}, "0.5": {...}}``) when GT exists;
+    thumbnails need the scene input (frames) and are skipped without it.
+    """
+    manifest_path = Path(manifest_path)
+    if manifest_path.is_dir():
+        manifest_path = manifest_path / "scene.json"
+    scene = InteractiveScene.load(manifest_path)
+    root = manifest_path.parent
+    thumbs: dict[str, list[str]] = {}
+    if thumbnails and scene_input is not None and scene.objects:
+        from .thumbnails import part_thumbnails
+
+        mesh_path = Path(scene.input_mesh)
+        mesh_path = mesh_path if mesh_path.is_absolute() else root / mesh_path
+        mesh = load_mesh(mesh_path)
+        parts = {}
+        for o in scene.objects:
+            if not o.source_vertex_ids:
+                continue
+            frames = [v["frame_id"] for v in o.top_views if "frame_id" in v] or ([o.seg_frame_id] if o.seg_frame_id else [])
+            parts[o.object_id] = (load_vertex_ids(root / o.source_vertex_ids), frames)
+        thumbs = part_thumbnails(scene_input, mesh, parts)
+    body = _parts_table(scene, thumbs) + (_metrics_table(metrics) if metrics else "") + _timings_table(scene.timings)
+    page = build_viewer_html(scene_payload(manifest_path), f"REACT3D · {scene.scene_id}", body, thumbs)
+    return write_text(Path(out_path) if out_path else root / "report.html", page)

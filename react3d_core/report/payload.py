@@ -1,0 +1,102 @@
+"""The data a browser viewer needs, as one JSON-able dict: meshes as base64 typed arrays, joints, boxes.
+
+Meshes are decimated to a face budget so a whole scan stays a few MB inside a single HTML file.
+"""
+
+from __future__ import annotations
+
+import base64
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..data.mesh import TriMesh, load_mesh
+from ..data.parts import InteractiveObject, InteractiveScene
+
+
+def _b64(a: np.ndarray) -> str:
+    return base64.b64encode(np.ascontiguousarray(a).tobytes()).decode("ascii")
+
+
+def decimate(mesh: TriMesh, max_faces: int) -> TriMesh:
+    """Quadric decimation (keeps vertex colours) when the mesh is over budget."""
+    if mesh.n_faces <= max_faces:
+        return mesh
+    o3 = mesh.to_open3d().simplify_quadric_decimation(int(max_faces))
+    cols = np.asarray(o3.vertex_colors)
+    return TriMesh(np.asarray(o3.vertices), np.asarray(o3.triangles), cols if len(cols) else None)
+
+
+def vertex_normals(mesh: TriMesh) -> np.ndarray:
+    """Area-weighted vertex normals (vectorized scatter-add)."""
+    v, f = mesh.vertices, mesh.faces
+    fn = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    n = np.zeros_like(v)
+    for k in range(3):
+        np.add.at(n, f[:, k], fn)
+    norm = np.linalg.norm(n, axis=1, keepdims=True)
+    return n / np.maximum(norm, 1e-12)
+
+
+def mesh_payload(mesh: TriMesh, max_faces: int) -> dict[str, Any]:
+    """Positions float32, normals int8, colours uint8, indices uint32 — base64."""
+    m = decimate(mesh, max_faces)
+    n = np.clip(np.round(vertex_normals(m) * 127), -127, 127).astype(np.int8)
+    return {
+        "positions": _b64(m.vertices.astype(np.float32)),
+        "normals": _b64(n),
+        "colors": _b64(m.colors.astype(np.uint8)),
+        "indices": _b64(m.faces.astype(np.uint32)),
+        "n_vertices": int(m.n_vertices),
+        "n_faces": int(m.n_faces),
+    }
+
+
+def _object_payload(obj: InteractiveObject, root: Path, max_faces: int) -> dict[str, Any]:
+    a = obj.articulation
+    out: dict[str, Any] = {
+        "id": obj.object_id,
+        "label": obj.label,
+        "score": obj.score,
+        "joint": {
+            "type": a.joint_type,
+            "axis": list(a.axis),
+            "origin": list(a.origin),
+            "lower": a.lower,
+            "upper": a.upper,
+            "limit_source": a.limit_source,
+        },
+        "obb": {"center": list(obj.obb.center), "axes": [list(x) for x in obj.obb.axes], "extents": list(obj.obb.extents)},
+        "cavity_depth": obj.cavity_depth,
+        "cavity_depth_source": obj.cavity_depth_source,
+        "top_views": obj.top_views,
+        "seg_frame_id": obj.seg_frame_id,
+        "meshes": {},
+    }
+    for key, rel in (("part", obj.part_mesh), ("base", obj.base_mesh), ("inner", obj.inner_mesh)):
+        if rel:
+            p = root / rel
+            if p.is_file():
+                out["meshes"][key] = mesh_payload(load_mesh(p), max_faces)
+    return out
+
+
+def scene_payload(
+    manifest_path: str | Path, max_background_faces: int = 150_000, max_object_faces: int = 20_000
+) -> dict[str, Any]:
+    """Everything the viewer draws, from a scene manifest (``scene.json`` or its folder)."""
+    manifest_path = Path(manifest_path)
+    if manifest_path.is_dir():
+        manifest_path = manifest_path / "scene.json"
+    scene = InteractiveScene.load(manifest_path)
+    root = manifest_path.parent
+    bg = load_mesh(root / scene.background_mesh)
+    return {
+        "scene_id": scene.scene_id,
+        "background": mesh_payload(bg, max_background_faces),
+        "bounds": bg.bounds().tolist(),
+        "objects": [_object_payload(o, root, max_object_faces) for o in scene.objects],
+        "timings": scene.timings,
+        "versions": scene.versions,
+    }

@@ -1,0 +1,57 @@
+"""The viewer payload and the HTML report (no browser needed)."""
+
+from __future__ import annotations
+
+import base64
+import json
+import re
+
+import numpy as np
+
+from react3d_core.data import TriMesh
+from react3d_core.report import scene_payload, write_report
+from react3d_core.report.payload import decimate, vertex_normals
+from react3d_core.report.thumbnails import thumbnail
+
+
+def test_payload_round_trips_arrays(toy_scene):
+    p = scene_payload(toy_scene)
+    assert [o["id"] for o in p["objects"]] == ["obj_000", "obj_001"]
+    part = p["objects"][0]["meshes"]["part"]
+    pos = np.frombuffer(base64.b64decode(part["positions"]), np.float32).reshape(-1, 3)
+    idx = np.frombuffer(base64.b64decode(part["indices"]), np.uint32).reshape(-1, 3)
+    assert pos.shape[0] == part["n_vertices"] and idx.max() < pos.shape[0]
+    assert np.allclose(pos.mean(0), [0.75, 1.91, 0.45], atol=1e-3)
+    assert p["objects"][1]["joint"]["type"] == "prismatic"
+
+
+def test_vertex_normals_of_a_flat_square_point_up():
+    m = TriMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]])
+    assert np.allclose(vertex_normals(m), [[0, 0, 1]] * 4)
+
+
+def test_decimate_respects_budget(toy_scene):
+    from react3d_core.data import load_mesh
+
+    m = load_mesh(toy_scene / "meshes" / "background.ply")
+    d = decimate(m, 500)
+    assert d.n_faces <= 500 and d.colors.shape == (d.n_vertices, 3)
+
+
+def test_report_is_self_contained(toy_scene, tmp_path):
+    out = write_report(toy_scene, tmp_path / "report.html", metrics={"0.25": {"f1": 0.5, "precision": 1.0}})
+    html = out.read_text()
+    assert "<script src=" not in html and "http://" not in html and "https://" not in html
+    payload = json.loads(re.search(r"window.REACT3D_SCENE=(\{.*?\});window.REACT3D_THUMBS", html, re.S).group(1))
+    assert len(payload["objects"]) == 2
+    assert "obj_001" in html and "Metrics against ground truth" in html and "Timings" in html
+
+
+def test_thumbnail_crops_around_the_silhouette():
+    rgb = np.zeros((100, 200, 3), np.uint8)
+    sil = np.zeros((100, 200), bool)
+    sil[40:60, 150:170] = True
+    t = thumbnail(rgb, sil, size=64)
+    assert t.shape[0] <= 64 and t.shape[1] <= 64
+    assert t[t.shape[0] // 2, t.shape[1] // 2].tolist() != [0, 0, 0]  # tinted part in the centre
+    assert thumbnail(rgb, np.zeros_like(sil)) is None
