@@ -32,9 +32,9 @@ def vertex_normals(mesh: TriMesh) -> np.ndarray:
     """Area-weighted vertex normals (vectorized scatter-add)."""
     v, f = mesh.vertices, mesh.faces
     fn = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    n = np.zeros_like(v)
-    for k in range(3):
-        np.add.at(n, f[:, k], fn)
+    idx = f.ravel()
+    rep = np.repeat(fn, 3, axis=0)
+    n = np.stack([np.bincount(idx, rep[:, k], minlength=len(v)) for k in range(3)], 1)
     norm = np.linalg.norm(n, axis=1, keepdims=True)
     return n / np.maximum(norm, 1e-12)
 
