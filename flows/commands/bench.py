@@ -1,0 +1,150 @@
+"""``react3d bench --scenes SPEC``: generate (if needed), convert, time, measure memory and evaluate a
+benchmark set; print one table and write the metrics JSON (see docs/evaluation.md).
+
+Each scene runs in a fresh spawned process so its peak RSS is its own (ru_maxrss never goes down).
+"""
+
+from __future__ import annotations
+
+import argparse
+import glob as globmod
+import json
+import multiprocessing as mp
+import resource
+import time
+from pathlib import Path
+from typing import Any
+
+from react3d_core.errors import InputError
+
+HELP = "Benchmark a scene set: convert each scene, time it, measure peak memory, evaluate against GT."
+
+SETS_DIR = Path(__file__).resolve().parents[2] / "benchmarks" / "sets"
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--scenes", required=True,
+                   help="A set file (benchmarks/sets/NAME.json, or just NAME) or a glob of scene folders.")
+    p.add_argument("--perception", choices=("oracle", "heuristic", "models"), default="heuristic")
+    p.add_argument("--no-refine", action="store_true", help="Disable axis/origin refinement (ablation).")
+    p.add_argument("--json", dest="json_path", help="Write the metrics JSON here.")
+    p.add_argument("--out", default="bench_out", help="Work folder: generated scenes, results, reports.")
+    p.add_argument("--frames", type=int, help="Override the set's frame count for generated scenes.")
+
+
+def load_spec(spec: str, out_dir: Path, frames: int | None = None) -> list[dict[str, Any]]:
+    """Scene entries {name, scene_dir | (source, kind, seed, n_frames)} from a set file or a glob."""
+    cand = Path(spec)
+    if not cand.suffix and not any(c in spec for c in "*?[") and (SETS_DIR / f"{spec}.json").is_file():
+        cand = SETS_DIR / f"{spec}.json"
+    if cand.suffix == ".json" and cand.is_file():
+        try:
+            d = json.loads(cand.read_text())
+            n = frames or int(d.get("n_frames", 60))
+            out = []
+            for e in d["scenes"]:
+                src, seed, kind = e.get("source", "procedural"), int(e["seed"]), e.get("kind")
+                name = f"{src}_{kind or 'any'}_{seed}"
+                out.append({"name": name, "source": src, "kind": kind, "seed": seed, "n_frames": int(e.get("n_frames", n)),
+                            "scene_dir": str(out_dir / "scenes" / f"{name}_f{int(e.get('n_frames', n))}")})
+            return out
+        except (KeyError, TypeError, ValueError, json.JSONDecodeError) as exc:
+            raise InputError(cand, f"bad benchmark set ({exc.__class__.__name__}: {exc})") from None
+    dirs = sorted(p for p in globmod.glob(spec) if Path(p).is_dir())
+    if not dirs:
+        raise InputError(spec, "neither a benchmark set file nor a glob matching scene folders")
+    return [{"name": Path(p).name, "scene_dir": p} for p in dirs]
+
+
+def _peak_rss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: KiB
+
+
+def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any]) -> dict[str, Any]:
+    """Child-process body: generate if missing, convert (timed), return timings and peak RSS."""
+    scene_dir = Path(entry["scene_dir"])
+    if "source" in entry and not (scene_dir / "scans").is_dir():
+        from react3d_core.synthetic import generate_scene
+
+        generate_scene(scene_dir, source=entry["source"], seed=entry["seed"], n_frames=entry["n_frames"], kind=entry.get("kind"))
+    from flows.convert_scene import convert_scene
+
+    rss0 = _peak_rss_mb()
+    t0 = time.perf_counter()
+    manifest = convert_scene(str(scene_dir), result_dir, config)
+    wall = time.perf_counter() - t0
+    return {"manifest": str(manifest), "wall_s": wall, "peak_rss_mb": _peak_rss_mb(), "rss_before_mb": rss0}
+
+
+def _gt_dir(scene_dir: Path) -> Path | None:
+    for c in (scene_dir / "articulate3d", scene_dir.parent / "articulate3d"):
+        if any(c.glob("*_parts.json")):
+            return c
+    return None
+
+
+def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, Any]) -> dict[str, Any]:
+    """Convert and evaluate every entry; failed scenes are reported in ``failed`` and skipped."""
+    from react3d_core.config.evaluation import EvaluationConfig
+    from react3d_core.data.parts import InteractiveScene
+    from react3d_core.ground_truth.articulate3d import read_articulate3d
+    from react3d_core.metrics import evaluate_scene, to_json_dict
+
+    ctx = mp.get_context("spawn")
+    scenes, failed = [], []
+    for e in entries:
+        res_dir = out_dir / "results" / e["name"]
+        try:
+            with ctx.Pool(1, maxtasksperchild=1) as pool:
+                r = pool.apply(run_one, (e, str(res_dir), config))
+            pred = InteractiveScene.load(r["manifest"])
+            gt_dir = _gt_dir(Path(e["scene_dir"]))
+            if gt_dir is None:
+                raise InputError(e["scene_dir"], "no articulate3d/ ground truth to evaluate against")
+            sm = evaluate_scene(pred, Path(r["manifest"]).parent, read_articulate3d(gt_dir), EvaluationConfig(**config.get("evaluation", {})))
+            sm.scene = e["name"]
+            sm.wall_s, sm.peak_rss_mb = r["wall_s"], r["peak_rss_mb"]
+            sm.frames = e.get("n_frames")
+            scenes.append(sm)
+        except Exception as exc:  # noqa: BLE001 - one failed scene must not stop the benchmark
+            failed.append({"scene": e["name"], "error": f"{exc.__class__.__name__}: {exc}"})
+    result = to_json_dict(scenes)
+    result["failed"] = failed
+    result["config"] = config
+    return result
+
+
+def print_table(result: dict[str, Any]) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    def f(v: Any, pct: bool = False) -> str:
+        return "–" if v is None else (f"{100 * v:.1f}" if pct else f"{v:.3f}" if isinstance(v, float) else str(v))
+
+    t = Table(title="react3d bench")
+    for c in ("scene", "GT", "pred", "frames", "faces", "wall s", "peak MB", "F1@.25", "F1@.5", "acc %", "MD m", "OE °", "+MOD %"):
+        t.add_column(c, justify="right" if c != "scene" else "left")
+    rows = [(s["scene"], s) for s in result["scenes"]] + [("ALL (pooled)", {"n_gt": sum(s["n_gt"] for s in result["scenes"]),
+            "n_pred": sum(s["n_pred"] for s in result["scenes"]), **result["aggregate"]})]
+    for name, s in rows:
+        a, b = s.get("0.25", {}), s.get("0.5", {})
+        t.add_row(name, f(s.get("n_gt")), f(s.get("n_pred")), f(s.get("frames")), f(s.get("faces")), f(s.get("wall_s")),
+                  f(s.get("peak_rss_mb")), f(a.get("f1")), f(b.get("f1")), f(a.get("joint_acc"), True), f(a.get("md")),
+                  f(a.get("oe")), f(a.get("mod"), True))
+    Console().print(t)
+    for fl in result.get("failed", []):
+        Console().print(f"[red]failed[/red] {fl['scene']}: {fl['error']}")
+
+
+def run(args: argparse.Namespace) -> int:
+    from react3d_core.atomic import write_json
+
+    out_dir = Path(args.out)
+    entries = load_spec(args.scenes, out_dir, args.frames)
+    config: dict[str, Any] = {"perception": {"backend": args.perception}}
+    if args.no_refine:
+        config["articulation"] = {"refine": False}
+    result = run_bench(entries, out_dir, config)
+    print_table(result)
+    write_json(args.json_path or out_dir / "bench.json", result)
+    return 0 if not result["failed"] else 1

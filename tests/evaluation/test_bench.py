@@ -1,0 +1,61 @@
+"""Bench plumbing: set files parse, failures are reported per scene, the table prints; densify keeps ids."""
+
+import importlib.util
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from flows.commands.bench import SETS_DIR, load_spec, print_table, run_bench
+from react3d_core.data.mesh import TriMesh, load_mesh, save_mesh
+from react3d_core.errors import InputError
+
+
+def test_set_files_are_valid(tmp_path):
+    heldout = load_spec("heldout", tmp_path)
+    assert 9 <= len(heldout) <= 12 and all(e["seed"] >= 100 for e in heldout)
+    assert {e["source"] for e in heldout} == {"procedural", "scene-synthesizer"}
+    assert len({e["name"] for e in heldout}) == len(heldout)
+    smoke = load_spec(str(SETS_DIR / "smoke.json"), tmp_path, frames=12)
+    assert len(smoke) == 2 and all(e["n_frames"] == 12 for e in smoke)
+
+
+def test_bad_spec_is_input_error(tmp_path):
+    with pytest.raises(InputError):
+        load_spec(str(tmp_path / "nothing_*"), tmp_path)
+    bad = tmp_path / "bad.json"
+    bad.write_text(json.dumps({"scenes": [{"source": "procedural"}]}))  # no seed
+    with pytest.raises(InputError):
+        load_spec(str(bad), tmp_path)
+
+
+def test_failed_scene_is_reported_not_raised(tmp_path, capsys):
+    (tmp_path / "empty_scene").mkdir()
+    entries = load_spec(str(tmp_path / "empty_*"), tmp_path)
+    res = run_bench(entries, tmp_path / "out", {"perception": {"backend": "oracle"}})
+    assert res["scenes"] == [] and res["failed"][0]["scene"] == "empty_scene"
+    print_table(res)
+    assert "failed" in capsys.readouterr().out
+
+
+def test_densify_keeps_original_vertices(tmp_path):
+    spec = importlib.util.spec_from_file_location("scaling", Path(__file__).parents[2] / "benchmarks" / "scaling.py")
+    scaling = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(scaling)
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], float)
+    f = np.array([[0, 1, 2], [1, 3, 2]])
+    (tmp_path / "s" / "scans").mkdir(parents=True)
+    save_mesh(tmp_path / "s" / "scans" / "mesh_aligned_0.05.ply", TriMesh(v, f))
+    assert scaling.densify(tmp_path / "s", 30) == 32  # 2 -> 8 -> 32 faces
+    m = load_mesh(tmp_path / "s" / "scans" / "mesh_aligned_0.05.ply")
+    np.testing.assert_allclose(m.vertices[:4], v)
+
+
+@pytest.mark.slow
+def test_smoke_set_end_to_end(tmp_path):
+    pytest.importorskip("react3d_core.synthetic")
+    pytest.importorskip("flows.convert_scene")
+    res = run_bench(load_spec("smoke", tmp_path, frames=20), tmp_path, {"perception": {"backend": "oracle"}})
+    assert not res["failed"], res["failed"]
+    assert res["aggregate"]["0.25"]["f1"] is not None
