@@ -82,3 +82,11 @@ def test_evaluate_multi_scene_layout_and_bad_input(gt_pred, tmp_path):
     with pytest.raises(InputError):
         run_evaluation(tmp_path / "nowhere", gt_pred[1])
     assert main(["evaluate", str(tmp_path / "nowhere"), str(gt_pred[1])]) == 2
+
+
+def test_prefect_flow_body(gt_pred, tmp_path):
+    from flows.evaluate import evaluate
+
+    res = evaluate.fn(str(gt_pred[0]), str(gt_pred[1]), str(tmp_path / "rep"))
+    assert res["aggregate"]["0.25"]["f1"] == 1.0
+    assert json.loads((tmp_path / "rep" / "metrics.json").read_text())["aggregate"] == res["aggregate"]
