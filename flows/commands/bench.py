@@ -95,6 +95,8 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
     for e in entries:
         res_dir = out_dir / "results" / e["name"]
         try:
+            if "source" not in e and not Path(e["scene_dir"]).is_dir():
+                raise InputError(e["scene_dir"], "scene folder not found")
             with ctx.Pool(1, maxtasksperchild=1) as pool:
                 r = pool.apply(run_one, (e, str(res_dir), config))
             pred = InteractiveScene.load(r["manifest"])
