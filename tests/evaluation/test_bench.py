@@ -38,10 +38,21 @@ def test_failed_scene_is_reported_not_raised(tmp_path, capsys):
     assert "failed" in capsys.readouterr().out
 
 
-def test_densify_keeps_original_vertices(tmp_path):
+def _scaling():
     spec = importlib.util.spec_from_file_location("scaling", Path(__file__).parents[2] / "benchmarks" / "scaling.py")
     scaling = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(scaling)
+    return scaling
+
+
+def test_scaling_plot_writes_png(tmp_path):
+    runs = [{"frames": n, "faces": None, "wall_s": n / 10, "peak_rss_mb": 100 + n, "stages": {"fusion": n / 20}} for n in (75, 150)]
+    _scaling().plot({"vs_frames": runs + [{"frames": 300, "error": "x"}], "vs_faces": []}, tmp_path / "s.png")
+    assert (tmp_path / "s.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_densify_keeps_original_vertices(tmp_path):
+    scaling = _scaling()
     v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]], float)
     f = np.array([[0, 1, 2], [1, 3, 2]])
     (tmp_path / "s" / "scans").mkdir(parents=True)
