@@ -3,7 +3,7 @@
 Supported here: the ScanNet++ iPhone layout (what the synthetic writer produces), the reference
 code's prepared layout (images_2/ + depth/ PNG), and a generic mesh + nerfstudio transforms.json.
 Conventions are converted at this boundary: every pose leaves as camera-to-world with OpenCV axes.
-Simplified: the ScanNet++ DSLR layout (fisheye undistortion + rendered depth) is not handled yet.
+and the ScanNet++ DSLR layout (dslr.py: fisheye undistortion + mesh-rendered depth into a cache folder).
 """
 
 from __future__ import annotations
@@ -89,6 +89,8 @@ def detect_layout(root: Path) -> str:
         return "prepared"
     if (root / "transforms.json").is_file():
         return "generic"
+    if (root / "dslr" / "colmap" / "images.txt").is_file():
+        return "scannetpp_dslr"
     raise InputError(root, "no known scene layout (expected iphone/pose_intrinsic_imu.json, images_2/ + pose_intrinsic_imu.json, or transforms.json)")
 
 
@@ -214,12 +216,25 @@ def _load_generic(root: Path, scannetpp_world: bool | None = None) -> SceneInput
 
 
 def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, *,
-               layout: str | None = None, scannetpp_world: bool | None = None) -> SceneInput:
-    """Load any supported layout (auto-detected unless ``layout`` is given), then select frames."""
+               layout: str | None = None, scannetpp_world: bool | None = None,
+               cache_dir: str | Path | None = None) -> SceneInput:
+    """Load any supported layout (auto-detected unless ``layout`` is given), then select frames.
+
+    ``cache_dir`` (DSLR only; default ``<scene>/.react3d_cache``) receives undistorted images and rendered depth."""
     root = Path(path)
     if not root.is_dir():
         raise InputError(root, "scene folder not found")
     layout = layout or detect_layout(root)
+    if layout == "scannetpp_dslr":
+        from .dslr import load_dslr_frames
+
+        mesh = _check_mesh(root / "scans" / "mesh_aligned_0.05.ply")
+        cache = Path(cache_dir) if cache_dir else root / ".react3d_cache"
+        sel = (lambda fs: select_frames(fs, selection)) if selection is not None else list
+        frames = load_dslr_frames(root, cache / "dslr", mesh, sel)
+        gt_dir = next((d for d in (root / "articulate3d", root.parent / "articulate3d") if d.is_dir()), None)
+        return SceneInput(scene_id=root.name, root=root, mesh_path=mesh, frames=tuple(frames),
+                          source_format="scannetpp_dslr", gt_dir=gt_dir)
     if layout == "scannetpp_iphone":
         scene = _load_iphone(root)
     elif layout == "prepared":
