@@ -78,7 +78,26 @@ def _check_mesh(path: Path) -> Path:
         raise InputError(path, "mesh file not found")
     if path.stat().st_size == 0:
         raise InputError(path, "mesh file is empty")
+    if path.suffix.lower() == ".ply":
+        _check_ply_header(path)
     return path
+
+
+def _check_ply_header(path: Path) -> None:
+    """Cheap corrupt/empty check from the PLY header alone (the full mesh is loaded only by the stages)."""
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
+    if not head.startswith(b"ply"):
+        raise InputError(path, "corrupt mesh: not a PLY file (missing 'ply' magic)")
+    if b"end_header" not in head:
+        raise InputError(path, "corrupt mesh: PLY header not terminated")
+    counts = {}
+    for line in head.split(b"end_header")[0].decode("ascii", "replace").splitlines():
+        t = line.split()
+        if len(t) == 3 and t[0] == "element" and t[2].isdigit():
+            counts[t[1]] = int(t[2])
+    if counts.get("vertex", 0) == 0 or counts.get("face", 0) == 0:
+        raise InputError(path, f"empty mesh: {counts.get('vertex', 0)} vertices, {counts.get('face', 0)} faces")
 
 
 def detect_layout(root: Path) -> str:

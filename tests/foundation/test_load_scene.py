@@ -127,3 +127,28 @@ def test_selection_stride_cap_keyframes(tmp_path: Path) -> None:
     kf = FrameSelectionConfig(stride=1, keyframes=True, keyframe_translation_m=0.4, keyframe_rotation_deg=179.0)
     assert len(select_frames(s.frames, kf)) == 10
     assert len(load_scene(s.root, FrameSelectionConfig(stride=2)).frames) == 5
+
+
+def test_corrupt_and_empty_mesh(tmp_path: Path) -> None:
+    root = make_iphone(tmp_path / "a")
+    mesh = root / "scans" / "mesh_aligned_0.05.ply"
+    mesh.write_bytes(b"garbage\x00\x01")
+    with pytest.raises(InputError, match="not a PLY"):
+        load_scene(root)
+    save_mesh(mesh, TriMesh(np.zeros((0, 3)), np.zeros((0, 3), int)))
+    with pytest.raises(InputError, match="empty mesh"):
+        load_scene(root)
+
+
+def test_generic_scannetpp_world_flag(tmp_path: Path) -> None:
+    from react3d_core.camera import c2w_to_nerfstudio_scannetpp
+
+    root = tmp_path / "dslr" / "nerfstudio"
+    root.mkdir(parents=True)
+    save_mesh(root / "mesh.ply", TriMesh(np.eye(3), np.array([[0, 1, 2]])))
+    cv2.imwrite(str(root / "a.jpg"), np.zeros((20, 30, 3), np.uint8))
+    T = _poses(2)[1]
+    fr = [{"file_path": "a.jpg", "transform_matrix": c2w_to_nerfstudio_scannetpp(T).tolist()}]
+    (root / "transforms.json").write_text(json.dumps({"fl_x": 20, "fl_y": 20, "cx": 15, "cy": 10, "w": 30, "h": 20, "frames": fr}))
+    assert np.abs(load_scene(root).frames[0].c2w - T).max() <= 1e-9  # auto-detected from dslr/nerfstudio
+    assert np.abs(load_scene(root, scannetpp_world=False).frames[0].c2w - T).max() > 0.1
