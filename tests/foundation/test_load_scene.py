@@ -152,3 +152,21 @@ def test_generic_scannetpp_world_flag(tmp_path: Path) -> None:
     (root / "transforms.json").write_text(json.dumps({"fl_x": 20, "fl_y": 20, "cx": 15, "cy": 10, "w": 30, "h": 20, "frames": fr}))
     assert np.abs(load_scene(root).frames[0].c2w - T).max() <= 1e-9  # auto-detected from dslr/nerfstudio
     assert np.abs(load_scene(root, scannetpp_world=False).frames[0].c2w - T).max() > 0.1
+
+
+def test_iphone_rgb_mkv_and_gt_part_ids(tmp_path: Path) -> None:
+    import shutil
+
+    root = make_iphone(tmp_path / "m")
+    shutil.rmtree(root / "iphone" / "rgb")
+    wr = cv2.VideoWriter(str(root / "iphone" / "rgb.mkv"), cv2.VideoWriter_fourcc(*"FFV1"), 10, (96, 72))
+    for i in range(4):
+        wr.write(np.full((72, 96, 3), 40 * i, np.uint8))
+    wr.release()
+    (root / "iphone" / "gt_part_ids").mkdir()
+    cv2.imwrite(str(root / "iphone" / "gt_part_ids" / "frame_000001.png"), np.ones((72, 96), np.uint16))
+    s = load_scene(root)
+    f = s.frames[2]
+    assert f.rgb.kind == "mkv" and f.rgb.index == 2 and f.intrinsics.width == 96
+    assert read_rgb(f.rgb).mean() == pytest.approx(80.0, abs=1.0)
+    assert s.frames[1].part_ids is not None and s.frames[0].part_ids is None
