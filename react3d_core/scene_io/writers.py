@@ -6,7 +6,6 @@ pixels are re-encoded from the ImageRefs (RGB as JPG/PNG, depth as depth.bin or 
 
 from __future__ import annotations
 
-import json
 import shutil
 from pathlib import Path
 
