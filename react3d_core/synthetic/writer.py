@@ -1,0 +1,104 @@
+"""Render a :class:`SynthLayout` and write it as a ScanNet++ iPhone scene with Articulate3D ground truth.
+
+Layout (docs/CONTRACTS.md section 2)::
+
+    scans/mesh_aligned_0.05.ply, iphone/pose_intrinsic_imu.json, iphone/rgb/frame_%06d.jpg,
+    iphone/depth.bin (per-frame LZ4), iphone/gt_part_ids/frame_%06d.png (uint16, partId + 1),
+    articulate3d/<scene_id>_{parts,artic}.json, synth_meta.json
+
+The folder appears whole or not at all (built in a temporary sibling and renamed).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import cv2
+import numpy as np
+
+from ..atomic import atomic_dir, write_json
+from ..data.mesh import save_mesh
+from ..ground_truth.articulate3d import GroundTruth, GTPart, write_articulate3d
+from ..scene_io.depth_bin import write_depth_bin
+from .camera_path import camera_walk
+from .procedural import SynthLayout
+from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, sensor_depth
+
+GENERATOR_VERSION = "1"
+
+
+def _gt_parts(layout: SynthLayout) -> tuple[list[GTPart], np.ndarray, list[dict]]:
+    """GT parts (movable, then handles, then static carcasses), the face -> partId table and meta rows."""
+    mesh, keys = layout.mesh, layout.face_keys
+    key_pid: dict[str, int] = {}
+    order: list[tuple[str, str, object]] = []
+    for p in layout.parts:
+        order.append((p.key, p.label, p))
+    for p in layout.parts:
+        if p.handle_key:
+            order.append((p.handle_key, p.label + ".handle", None))
+    for k, label in layout.statics.items():
+        order.append((k, f"{label}.{k}" if not k.startswith(label) else k, None))
+    for i, (k, _, _) in enumerate(order):
+        key_pid[k] = i
+    lut = np.full(len(layout.key_ids) + 1, -1, np.int64)
+    for k, kid in layout.key_ids.items():
+        if k in key_pid:
+            lut[kid] = key_pid[k]
+    face_pid = lut[keys]  # keys == -1 index the trailing -1 entry
+    parts, meta = [], []
+    for pid, (k, label, spec) in enumerate(order):
+        tri = np.flatnonzero(face_pid == pid)
+        vert = np.unique(mesh.faces[tri].ravel())
+        art = spec.articulation if spec is not None else None  # type: ignore[union-attr]
+        base = [key_pid[spec.parent_key]] if spec is not None and spec.parent_key in key_pid else []  # type: ignore[union-attr]
+        parts.append(GTPart(pid, label, tri, vert, art, base))
+        if spec is not None:
+            meta.append({"part_id": pid, "label": label, "kind": spec.kind, "type": art.joint_type,  # type: ignore[union-attr]
+                         "handle": spec.handle_key is not None,  # type: ignore[union-attr]
+                         "handle_part_id": key_pid.get(spec.handle_key) if spec.handle_key else None,  # type: ignore[union-attr]
+                         "parent_part_id": base[0] if base else None,
+                         "interior_depth": spec.interior_depth, "n_faces": int(len(tri))})  # type: ignore[union-attr]
+    return parts, face_pid, meta
+
+
+def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, seed: int, source: str,
+                    scene_id: str | None = None, room_depths: list[float] | None = None) -> Path:
+    """Render ``n_frames`` views of ``layout`` and write the scene folder; returns ``out_dir``."""
+    out_dir = Path(out_dir)
+    if n_frames < 1:
+        raise ValueError("n_frames must be >= 1")
+    rng = np.random.default_rng(seed + 1_000_003)
+    scene_id = scene_id or out_dir.name
+    gt_parts, face_pid, meta = _gt_parts(layout)
+    K = base_intrinsics(rng)
+    K_rgb, K_d = scale_K(K, RGB_SIZE[0]), scale_K(K, DEPTH_SIZE[0])
+    if room_depths is None:
+        room_depths = [5.0] * len(layout.runs)
+    poses = camera_walk(layout.runs, n_frames, room_depths, rng)
+    caster = RayCaster(layout.mesh)
+    with atomic_dir(out_dir) as tmp:
+        (tmp / "iphone" / "rgb").mkdir(parents=True)
+        (tmp / "iphone" / "gt_part_ids").mkdir(parents=True)
+        save_mesh(tmp / "scans" / "mesh_aligned_0.05.ply", layout.mesh)
+        depths, pose_json = [], {}
+        for i, c2w in enumerate(poses):
+            fid = f"frame_{i:06d}"
+            hit = caster.cast(K_rgb, c2w, *RGB_SIZE)
+            rgb = caster.rgb(hit, rng)
+            cv2.imwrite(str(tmp / "iphone" / "rgb" / f"{fid}.jpg"), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR),
+                        [cv2.IMWRITE_JPEG_QUALITY, 92])
+            face = hit["face"]
+            pid = np.where(face >= 0, face_pid[np.maximum(face, 0)] + 1, 0)
+            cv2.imwrite(str(tmp / "iphone" / "gt_part_ids" / f"{fid}.png"), pid.astype(np.uint16))
+            dhit = caster.cast(K_d, c2w, *DEPTH_SIZE)
+            depths.append(sensor_depth(dhit["depth"], rng))
+            pose_json[fid] = {"intrinsic": K.tolist(), "aligned_pose": c2w.tolist(), "timestamp": round(i / 10.0, 3)}
+        write_depth_bin(tmp / "iphone" / "depth.bin", depths, "per_frame")
+        write_json(tmp / "iphone" / "pose_intrinsic_imu.json", pose_json)
+        write_articulate3d(tmp / "articulate3d", GroundTruth(scene_id, gt_parts, layout.mesh.n_faces, layout.mesh.n_vertices))
+        write_json(tmp / "synth_meta.json", {
+            "generator_version": GENERATOR_VERSION, "source": source, "seed": seed, "kind": layout.kind,
+            "scene_id": scene_id, "n_frames": len(poses), "room": list(layout.room),
+            "faces": layout.mesh.n_faces, "vertices": layout.mesh.n_vertices, "parts": meta, **layout.extra})
+    return out_dir
