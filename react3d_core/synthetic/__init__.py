@@ -20,28 +20,30 @@ __all__ = ["KINDS", "SOURCES", "STAGE_VERSION", "build_room", "demo_scene", "gen
 
 def _room_depths(layout: SynthLayout) -> list[float]:
     W, L, _ = layout.room
-    return [L if abs(np.sin(r.frame.theta)) < 0.5 else W for r in layout.runs]
+    return [r.free_depth if r.free_depth is not None else (L if abs(np.sin(r.frame.theta)) < 0.5 else W)
+            for r in layout.runs]
 
 
 def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 0, n_frames: int = 60,
-                   urdf_path: str | Path | None = None, kind: str | None = None, edge: float = 0.03) -> Path:
+                   urdf_path: str | Path | None = None, kind: str | None = None, edge: float | None = None) -> Path:
     """Build, render and write one synthetic scene; returns ``out_dir``.
 
     ``kind`` picks the procedural room type (default by seed), ``edge`` the triangle size of the
-    furniture (smaller = denser meshes, for scaling benchmarks).
+    furniture (smaller = denser meshes, for scaling benchmarks; default 3 cm procedural, 5 cm others).
     """
+    edge = edge if edge is not None else (0.03 if source == "procedural" else 0.05)
     if source == "procedural":
         layout = build_room(seed, kind, edge=edge)
     elif source == "scene-synthesizer":
         from .from_scene_synthesizer import build_scene_synthesizer
 
-        layout = build_scene_synthesizer(seed)
+        layout = build_scene_synthesizer(seed, edge=edge)
     elif source == "urdf":
         if urdf_path is None:
             raise ValueError("source='urdf' needs urdf_path")
         from .from_urdf import build_from_urdf
 
-        layout = build_from_urdf(Path(urdf_path), seed)
+        layout = build_from_urdf(Path(urdf_path), seed, edge=edge)
     else:
         raise ValueError(f"unknown source {source!r}; choose from {', '.join(SOURCES)}")
     return write_synthetic(layout, out_dir, n_frames, seed, source, room_depths=_room_depths(layout))

@@ -95,3 +95,30 @@ class MeshBuilder:
         """The merged mesh, the part-key id of every face (-1 = none) and the key -> id table."""
         mesh = TriMesh(np.concatenate(self._verts), np.concatenate(self._faces), np.concatenate(self._cols))
         return mesh, np.concatenate(self._keys), dict(self._key_ids)
+
+
+def bisect_to_size(verts: np.ndarray, faces: np.ndarray, edge: float, max_iter: int = 16) -> tuple[np.ndarray, np.ndarray]:
+    """Split every triangle at the midpoint of its longest edge until all edges are <= ``edge``.
+
+    Unlike uniform 1-to-4 subdivision, long thin triangles (box primitives) are only split across
+    their length, so the face count follows the surface area. New vertices are not shared with the
+    neighbouring triangle (T-junctions lie exactly on the neighbour's edge, so no cracks appear).
+    """
+    v = np.asarray(verts, float)
+    f = np.asarray(faces, np.int64)
+    for _ in range(max_iter):
+        p = v[f]
+        lens = np.linalg.norm(p[:, [1, 2, 0]] - p, axis=2)  # edge k runs from corner k to corner k+1
+        k = lens.argmax(1)
+        split = lens[np.arange(len(f)), k] > edge
+        if not split.any():
+            break
+        fs, ks = f[split], k[split]
+        a = fs[np.arange(len(fs)), ks]
+        b = fs[np.arange(len(fs)), (ks + 1) % 3]
+        c = fs[np.arange(len(fs)), (ks + 2) % 3]
+        mid = np.arange(len(v), len(v) + len(fs))
+        v = np.concatenate([v, 0.5 * (v[a] + v[b])])
+        # (a, mid, c) and (mid, b, c) keep the winding of (a, b, c)
+        f = np.concatenate([f[~split], np.stack([a, mid, c], 1), np.stack([mid, b, c], 1)])
+    return v, f

@@ -29,6 +29,7 @@ class ViewRun:
     z0: float
     z1: float
     depth: float  # how far the furniture sticks out of the wall
+    free_depth: float | None = None  # free space in front of the wall (default: from the room size)
 
 
 @dataclass
@@ -54,10 +55,10 @@ def wall_frames(W: float, L: float) -> list[tuple[WallFrame, float]]:
     ]
 
 
-def _shell(m: MeshBuilder, rng: np.random.Generator, W: float, L: float, H: float,
+def shell(m: MeshBuilder, rng: np.random.Generator, W: float, L: float, H: float,
            door: tuple[int, float, float, float] | None) -> None:
     """Floor, ceiling and four walls; ``door`` = (wall index, x0, width, height) cuts an opening."""
-    edge, m.edge = m.edge, 0.12
+    edge, m.edge = m.edge, max(0.12, float(np.sqrt(W * L)) / 35.0)  # plain walls: coarse, like a decimated scan
     wall_col = tuple(int(c) for c in rng.integers(200, 245, 3))
     m.add_box([-WALL_T, -WALL_T, -0.05], [W + WALL_T, L + WALL_T, 0.0], tuple(int(c) for c in rng.integers(110, 170, 3)))
     m.add_box([-WALL_T, -WALL_T, H], [W + WALL_T, L + WALL_T, H + 0.05], (235, 235, 235))
@@ -172,7 +173,7 @@ def build_room(seed: int, kind: str | None = None, edge: float = 0.03) -> SynthL
         length = frames[k][1]
         dw = float(rng.uniform(0.8, 0.95))
         door = (k, float(rng.uniform(0.4, length - dw - 0.4)), dw, float(rng.uniform(2.0, 2.1)))
-    _shell(m, rng, W, L, H, door)
+    shell(m, rng, W, L, H, door)
     if door is not None:
         fr = frames[door[0]][0]
         b.room_door(fr, door[1], door[2], door[3], WALL_T, PALETTES[int(rng.integers(len(PALETTES)))])
