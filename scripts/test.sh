@@ -6,6 +6,7 @@ bash scripts/setup.sh test
 if ! command -v chromium >/dev/null && command -v apt-get >/dev/null; then
   echo "[test] installing Debian chromium for the viewer tests ..."
   SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq || true
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium >/dev/null || echo "[test] chromium unavailable: browser tests will be skipped"
 fi
 export TMPDIR="${TMPDIR:-/tmp}"
