@@ -15,6 +15,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="Procedural room type (default: chosen by seed).")
     p.add_argument("--frames", type=int, default=60, help="Number of RGB-D frames to render.")
     p.add_argument("--urdf", default=None, help="Articulated URDF for --source urdf.")
+    p.add_argument("--preview", action="store_true", help="Also write preview.png (frames beside GT part ids).")
     p.add_argument("--edge", type=float, default=None, help="Furniture triangle size in metres (default 0.03 procedural, 0.05 others).")
 
 
@@ -33,6 +34,10 @@ def run(args: argparse.Namespace) -> int:
         out = generate_scene(args.out, source=args.source, seed=args.seed, n_frames=args.frames,
                              urdf_path=args.urdf, kind=args.kind, edge=args.edge)
     meta = json.loads((Path(out) / "synth_meta.json").read_text())
+    if args.preview:
+        from react3d_core.synthetic.preview import write_preview
+
+        console.print(f"preview: {write_preview(out)}")
     types = [p["type"] for p in meta["parts"]]
     console.print(f"[green]wrote[/green] {out}: {meta['kind']}, {meta['faces']} faces, {meta['n_frames']} frames, "
                   f"{len(types)} joints ({types.count('revolute')} revolute, {types.count('prismatic')} prismatic) "

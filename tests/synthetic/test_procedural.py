@@ -124,6 +124,7 @@ def test_handles_are_children_and_cavity_depth_is_true(synthetic_scene) -> None:
 def test_synth_cli(tmp_path: Path) -> None:
     from flows.cli import main
 
-    assert main(["synth", "--seed", "2", "--out", str(tmp_path / "s"), "--frames", "3", "--kind", "wardrobe"]) == 0
+    assert main(["synth", "--seed", "2", "--out", str(tmp_path / "s"), "--frames", "3", "--kind", "wardrobe", "--preview"]) == 0
+    assert (tmp_path / "s" / "preview.png").stat().st_size > 1000
     meta = json.loads((tmp_path / "s" / "synth_meta.json").read_text())
     assert meta["n_frames"] == 3 and meta["kind"] == "wardrobe"
