@@ -19,3 +19,10 @@ class ExportConfig(StageConfig):
     joint_velocity: float = Field(1.0, gt=0, description="URDF velocity limit.")
     joint_damping: float = Field(1.0, ge=0, description="Joint damping.")
     ros_package: bool = Field(False, description="Also write a ROS 2 description package with package:// paths.")
+    xatlas_max_faces: int = Field(
+        20000, ge=1, description="Meshes up to this many faces get xatlas charts; larger ones the per-triangle cell atlas (xatlas ~3 s/20k faces, crashed at 80k)."
+    )
+    min_collision_thickness: float = Field(0.005, gt=0, description="Convex pieces thinner than this (m) become boxes this thick (flat scans have no volume).")
+    background_patch_m: float = Field(0.5, gt=0, description="MJCF background collision: grid cell (m) of the planar convex patches.")
+    ros_launch: bool = Field(True, description="Write RViz launch files beside the URDF.")
+    write_glb: bool = Field(True, description="Also write a GLB per link (viewers; simulators read the OBJ).")
