@@ -1,0 +1,144 @@
+"""Collision geometry: convex pieces for moving/fixed-base bodies, planar patches for MuJoCo's background.
+
+Simulators turn one concave mesh into its convex hull (a drawer becomes a solid block), so every
+body gets a list of convex pieces, each written as its own collision element:
+- a connected component that is already convex (a box wall of a generated base, a watertight box)
+  is kept as its hull: the direct, exact and cheap decomposition of box-like bases;
+- an open scan surface (a door or drawer front) has no inside to decompose: its hull is used;
+- a watertight concave component goes through CoACD (capped at the remaining piece budget).
+Pieces thinner than ``min_collision_thickness`` become boxes that thick (a flat scan has no volume).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import trimesh
+
+from ..data.mesh import TriMesh
+
+MAX_HULL_VERTICES = 200  # PhysX caps a hull at 255 vertices by default
+
+
+@dataclass
+class ConvexPiece:
+    """A closed convex triangle mesh (outward faces), world coordinates."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    source: str  # "component", "hull", "coacd", "box", "patch"
+
+    @property
+    def volume(self) -> float:
+        return float(trimesh.Trimesh(self.vertices, self.faces, process=False).volume)
+
+
+def _pca_frame(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centre, axes (columns, right-handed) and extents of the PCA box of ``points`` (robust to flat sets)."""
+    c = points.mean(0)
+    _, _, vt = np.linalg.svd(points - c, full_matrices=False)
+    R = vt.T if vt.shape[0] == 3 else np.eye(3)
+    if np.linalg.det(R) < 0:
+        R[:, 2] *= -1
+    local = (points - c) @ R
+    lo, hi = local.min(0), local.max(0)
+    return c + R @ ((lo + hi) / 2), R, hi - lo
+
+
+def _box_from_points(points: np.ndarray, min_thickness: float) -> tuple[np.ndarray, np.ndarray]:
+    """PCA box of ``points`` with every extent at least ``min_thickness``."""
+    c, R, ext = _pca_frame(points)
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = c
+    box = trimesh.creation.box(extents=np.maximum(ext, min_thickness), transform=T)
+    return np.asarray(box.vertices), np.asarray(box.faces)
+
+
+def convex_piece(points: np.ndarray, min_thickness: float, source: str) -> ConvexPiece:
+    """Convex hull of ``points`` (low-poly, at least ``min_thickness`` thick)."""
+    pts = np.unique(np.asarray(points, float), axis=0)
+    if len(pts) == 0:
+        raise ValueError("no points for a convex piece")
+    if len(pts) >= 4 and np.min(_pca_frame(pts)[2]) >= min_thickness:
+        hull = trimesh.Trimesh(pts, process=False).convex_hull
+        k = 16
+        while len(hull.vertices) > MAX_HULL_VERTICES:
+            cell = np.ptp(hull.vertices, 0).max() / k
+            snapped = np.unique(np.round(hull.vertices / cell) * cell, axis=0)
+            hull = trimesh.Trimesh(snapped, process=False).convex_hull
+            k = max(2, k // 2)
+        return ConvexPiece(np.asarray(hull.vertices), np.asarray(hull.faces), source)
+    v, f = _box_from_points(pts, min_thickness)
+    return ConvexPiece(v, f, "box")
+
+
+def _components(mesh: TriMesh) -> list[trimesh.Trimesh]:
+    tm = trimesh.Trimesh(mesh.vertices, mesh.faces, process=False)
+    tm.merge_vertices()
+    parts = tm.split(only_watertight=False)
+    return sorted(parts, key=lambda p: -float(np.prod(np.ptp(p.vertices, 0) + 1e-3)))
+
+
+def convex_pieces(mesh: TriMesh, max_pieces: int = 16, min_thickness: float = 0.005, convex_tol: float = 0.02) -> list[ConvexPiece]:
+    """Decompose ``mesh`` into at most ``max_pieces`` convex pieces (see module doc for the rules)."""
+    if mesh.n_faces == 0:
+        return []
+    comps = _components(mesh)
+    if len(comps) > max_pieces:  # many fragments: keep the largest, hull the rest together
+        rest = np.vstack([c.vertices for c in comps[max_pieces - 1 :]])
+        comps = comps[: max_pieces - 1]
+        extra = [convex_piece(rest, min_thickness, "hull")]
+    else:
+        extra = []
+    pieces: list[ConvexPiece] = []
+    budget = max_pieces - len(extra)
+    for i, comp in enumerate(comps):
+        left = budget - len(pieces) - (len(comps) - i - 1)
+        if comp.is_watertight and comp.volume > 0:
+            hull_vol = comp.convex_hull.volume
+            if comp.volume >= (1 - convex_tol) * hull_vol or left <= 1:
+                pieces.append(convex_piece(comp.vertices, min_thickness, "component"))
+                continue
+            pieces.extend(_coacd(comp, left, min_thickness))
+        else:
+            pieces.append(convex_piece(comp.vertices, min_thickness, "hull"))
+    return pieces + extra
+
+
+def _coacd(comp: trimesh.Trimesh, max_pieces: int, min_thickness: float) -> list[ConvexPiece]:
+    import coacd
+
+    coacd.set_log_level("error")
+    parts = coacd.run_coacd(
+        coacd.Mesh(np.asarray(comp.vertices), np.asarray(comp.faces)), threshold=0.05, max_convex_hull=max_pieces, seed=0,
+        max_ch_vertex=MAX_HULL_VERTICES,
+    )
+    return [convex_piece(np.asarray(v), min_thickness, "coacd") for v, _ in parts]
+
+
+def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[ConvexPiece]:
+    """Static background for engines that convexify every mesh (MuJoCo): thin convex patches.
+
+    Simplified path: faces are grouped by grid cell of their centroid and by dominant normal direction
+    (+-x, +-y, +-z), each group becomes the hull of its vertices, so floors and walls become slabs
+    and a corner never becomes a solid wedge.
+    """
+    v, f = mesh.vertices, mesh.faces
+    if not len(f):
+        return []
+    tri = v[f]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    keep = np.linalg.norm(n, axis=1) > 1e-15
+    tri, n = tri[keep], n[keep]
+    axis = np.argmax(np.abs(n), axis=1)
+    direction = axis * 2 + (n[np.arange(len(n)), axis] > 0)
+    cells = np.floor(tri.mean(1) / cell).astype(np.int64)
+    key = np.column_stack([cells, direction])
+    _, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    order = np.argsort(inv, kind="stable")
+    bounds = np.flatnonzero(np.diff(inv[order])) + 1
+    groups = np.split(order, bounds)
+    return [convex_piece(tri[g].reshape(-1, 3), min_thickness, "patch") for g in groups]
