@@ -1,0 +1,208 @@
+"""USD writer (usd-core, UsdPhysics): one stage in metres, z up, kilograms.
+
+Per object: an Xform carrying ``ArticulationRootAPI`` (exactly one root per articulation) holding a
+base rigid body fixed to the world, a part rigid body and its revolute/prismatic joint. UsdPhysics
+joint axes are only X/Y/Z, so both local joint frames are rotated to map +X onto the articulation
+axis (an axis near -X uses a half turn about Z, where the shortest-arc formula breaks down); body0's
+and body1's frames are the same world frame, so PhysX does not move bodies at load. Moving bodies
+get convex colliders only; the static background keeps its triangle mesh. Mesh data lives inside the
+stage (usd-core cannot reference OBJ/GLB); baked textures are PNGs beside it, bound through
+UsdPreviewSurface + UsdUVTexture + a ``st`` primvar reader.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import cv2
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from ..atomic import atomic_path
+from ..config.export import ExportConfig
+from ..texture import TexturedMesh
+from .collision import ConvexPiece
+from .model import Link, SceneModel
+
+
+def align_x(axis: np.ndarray) -> np.ndarray:
+    """Rotation matrix R with R @ e_x = axis (unit)."""
+    a = np.asarray(axis, float)
+    a = a / np.linalg.norm(a)
+    c = float(a[0])
+    if c < -1.0 + 1e-9:
+        return np.diag([-1.0, -1.0, 1.0])  # half turn about z
+    v = np.array([0.0, -a[2], a[1]])  # e_x x a
+    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    return np.eye(3) + K + K @ K / (1.0 + c)
+
+
+def _quatf(R: np.ndarray):  # noqa: ANN202
+    from pxr import Gf
+
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    return Gf.Quatf(float(w), Gf.Vec3f(float(x), float(y), float(z)))
+
+
+def _vec3f(v: np.ndarray):  # noqa: ANN202
+    from pxr import Gf
+
+    return Gf.Vec3f(*(float(x) for x in v))
+
+
+def _define_mesh(stage, path: str, vertices: np.ndarray, faces: np.ndarray):  # noqa: ANN001, ANN202
+    from pxr import UsdGeom, Vt
+
+    mesh = UsdGeom.Mesh.Define(stage, path)
+    pts = np.ascontiguousarray(vertices, np.float32)
+    mesh.CreatePointsAttr(Vt.Vec3fArray.FromNumpy(pts))
+    mesh.CreateFaceVertexCountsAttr(Vt.IntArray.FromNumpy(np.full(len(faces), 3, np.int32)))
+    mesh.CreateFaceVertexIndicesAttr(Vt.IntArray.FromNumpy(np.ascontiguousarray(faces, np.int32).ravel()))
+    mesh.CreateSubdivisionSchemeAttr(UsdGeom.Tokens.none)
+    mesh.CreateExtentAttr(Vt.Vec3fArray.FromNumpy(np.stack([pts.min(0), pts.max(0)])))
+    return mesh
+
+
+def _material(stage, name: str, texture_rel: str):  # noqa: ANN001, ANN202
+    from pxr import Sdf, UsdShade
+
+    root = f"/World/Looks/{name}"
+    mat = UsdShade.Material.Define(stage, root)
+    pbr = UsdShade.Shader.Define(stage, f"{root}/PreviewSurface")
+    pbr.CreateIdAttr("UsdPreviewSurface")
+    pbr.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(0.8)
+    pbr.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(0.0)
+    reader = UsdShade.Shader.Define(stage, f"{root}/stReader")
+    reader.CreateIdAttr("UsdPrimvarReader_float2")
+    reader.CreateInput("varname", Sdf.ValueTypeNames.String).Set("st")
+    tex = UsdShade.Shader.Define(stage, f"{root}/diffuseTexture")
+    tex.CreateIdAttr("UsdUVTexture")
+    tex.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(Sdf.AssetPath(texture_rel))
+    tex.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
+    tex.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set("clamp")
+    tex.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set("clamp")
+    tex.CreateOutput("rgb", Sdf.ValueTypeNames.Float3)
+    pbr.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).ConnectToSource(tex.ConnectableAPI(), "rgb")
+    mat.CreateSurfaceOutput().ConnectToSource(pbr.ConnectableAPI(), "surface")
+    return mat
+
+
+def _visuals(stage, prim_path: str, link: Link, folder: Path) -> None:  # noqa: ANN001
+    from pxr import Sdf, UsdGeom, UsdShade, Vt
+
+    for k, tm in enumerate(link.visuals):
+        name = f"{link.name}_visual_{k}"
+        mesh = _define_mesh(stage, f"{prim_path}/{name}", tm.vertices - link.frame, tm.faces)
+        st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
+        st.Set(Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(tm.uv, np.float32)))
+        rel = f"textures/{name}.png"
+        _write_png(folder / rel, tm)
+        UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(_material(stage, name, f"./{rel}"))
+
+
+def _write_png(path: Path, tm: TexturedMesh) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_path(path) as tmp:
+        if not cv2.imwrite(str(tmp), np.ascontiguousarray(tm.image[..., ::-1])):
+            raise OSError(f"cannot write {path}")
+
+
+def _colliders(stage, prim_path: str, pieces: list[ConvexPiece], frame: np.ndarray) -> None:  # noqa: ANN001
+    from pxr import UsdGeom, UsdPhysics
+
+    for k, piece in enumerate(pieces):
+        mesh = _define_mesh(stage, f"{prim_path}/collisions/piece_{k}", piece.vertices - frame, piece.faces)
+        mesh.CreatePurposeAttr(UsdGeom.Tokens.guide)
+        UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
+        UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.convexHull)
+
+
+def _body(stage, path: str, link: Link, folder: Path):  # noqa: ANN001, ANN202
+    from pxr import UsdGeom, UsdPhysics
+
+    xf = UsdGeom.Xform.Define(stage, path)
+    xf.AddTranslateOp().Set(tuple(float(x) for x in link.frame))
+    UsdPhysics.RigidBodyAPI.Apply(xf.GetPrim())
+    inn = link.inertial
+    if inn is not None:
+        mass = UsdPhysics.MassAPI.Apply(xf.GetPrim())
+        mass.CreateMassAttr(float(inn.mass))
+        mass.CreateCenterOfMassAttr(_vec3f(inn.com - link.frame))
+        mass.CreateDiagonalInertiaAttr(_vec3f(inn.moments))
+        mass.CreatePrincipalAxesAttr(_quatf(inn.axes))
+    _visuals(stage, path, link, folder)
+    _colliders(stage, path, link.collisions, link.frame)
+    return xf
+
+
+def write_usd(model: SceneModel, path: str | Path, config: ExportConfig) -> Path:
+    """Write ``scene.usda`` (+ ``textures/``) for ``model``."""
+    from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
+
+    path = Path(path)
+    folder = path.parent
+    stage = Usd.Stage.CreateInMemory()
+    UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
+    UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+    UsdPhysics.SetStageKilogramsPerUnit(stage, 1.0)
+    world = UsdGeom.Xform.Define(stage, "/World")
+    stage.SetDefaultPrim(world.GetPrim())
+    scene = UsdPhysics.Scene.Define(stage, "/World/PhysicsScene")
+    scene.CreateGravityDirectionAttr(Gf.Vec3f(0, 0, -1))
+    scene.CreateGravityMagnitudeAttr(9.81)
+
+    bg = model.link("background")
+    UsdGeom.Xform.Define(stage, "/World/background")
+    _visuals(stage, "/World/background", bg, folder)
+    if bg.static_mesh is not None:
+        col = _define_mesh(stage, "/World/background/collision", bg.static_mesh.vertices, bg.static_mesh.faces)
+        col.CreatePurposeAttr(UsdGeom.Tokens.guide)
+        UsdPhysics.CollisionAPI.Apply(col.GetPrim())
+        UsdPhysics.MeshCollisionAPI.Apply(col.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.none)
+
+    for j in model.joints:
+        oid = j.child[: -len("__part")]
+        root = f"/World/{oid}"
+        UsdGeom.Xform.Define(stage, root)
+        UsdPhysics.ArticulationRootAPI.Apply(stage.GetPrimAtPath(root))
+        parent = model.link(j.parent)
+        part = model.link(j.child)
+        body0: str | None = None
+        if parent.role == "base":
+            body0 = f"{root}/base"
+            _body(stage, body0, parent, folder)
+            fixed = UsdPhysics.FixedJoint.Define(stage, f"{root}/base_fixed")
+            fixed.CreateBody1Rel().SetTargets([Sdf.Path(body0)])
+            fixed.CreateLocalPos0Attr(_vec3f(parent.frame))
+            fixed.CreateLocalRot0Attr(Gf.Quatf(1.0))
+            fixed.CreateLocalPos1Attr(Gf.Vec3f(0, 0, 0))
+            fixed.CreateLocalRot1Attr(Gf.Quatf(1.0))
+        body1 = f"{root}/part"
+        _body(stage, body1, part, folder)
+        a = j.articulation
+        revolute = a.joint_type == "revolute"
+        joint = (UsdPhysics.RevoluteJoint if revolute else UsdPhysics.PrismaticJoint).Define(stage, f"{root}/joint")
+        joint.CreateAxisAttr(UsdPhysics.Tokens.x)
+        if body0 is not None:
+            joint.CreateBody0Rel().SetTargets([Sdf.Path(body0)])
+        joint.CreateBody1Rel().SetTargets([Sdf.Path(body1)])
+        R = _quatf(align_x(np.asarray(a.axis)))
+        origin0 = part.frame - (parent.frame if body0 is not None else np.zeros(3))
+        joint.CreateLocalPos0Attr(_vec3f(origin0))
+        joint.CreateLocalRot0Attr(R)
+        joint.CreateLocalPos1Attr(Gf.Vec3f(0, 0, 0))
+        joint.CreateLocalRot1Attr(R)
+        scale = 180.0 / math.pi if revolute else 1.0
+        joint.CreateLowerLimitAttr(float(a.lower * scale))
+        joint.CreateUpperLimitAttr(float(a.upper * scale))
+        if config.joint_damping > 0:
+            drive = UsdPhysics.DriveAPI.Apply(joint.GetPrim(), "angular" if revolute else "linear")
+            drive.CreateTypeAttr("force")
+            drive.CreateStiffnessAttr(0.0)
+            drive.CreateDampingAttr(float(config.joint_damping / scale))  # per degree for revolute
+            drive.CreateMaxForceAttr(float(config.joint_effort))
+    with atomic_path(path) as tmp:
+        if not stage.GetRootLayer().Export(str(tmp)):
+            raise OSError(f"cannot write {path}")
+    return path
