@@ -21,7 +21,7 @@ class LinkFiles:
     visuals: list[str] = field(default_factory=list)  # OBJ paths (each with its MTL/PNG beside it)
     textures: list[str] = field(default_factory=list)  # PNG paths, same order
     collisions: list[str] = field(default_factory=list)  # convex OBJ per piece
-    static: str | None = None  # background triangle mesh OBJ
+    patches: list[str] = field(default_factory=list)  # background convex patches, one OBJ each
 
 
 def write_plain_obj(path: Path, vertices: np.ndarray, faces: np.ndarray) -> Path:
@@ -49,8 +49,8 @@ def write_link_assets(model: SceneModel, folder: Path, glb: bool = True, collisi
             for k, piece in enumerate(link.collisions):
                 p = write_plain_obj(d / f"collision_{k}.obj", piece.vertices - link.frame, piece.faces)
                 files.collisions.append(p.relative_to(folder).as_posix())
-            if link.static_mesh is not None:
-                p = write_plain_obj(d / "collision.obj", link.static_mesh.vertices - link.frame, link.static_mesh.faces)
-                files.static = p.relative_to(folder).as_posix()
+            for k, piece in enumerate(link.patches):
+                p = write_plain_obj(d / "patches" / f"patch_{k}.obj", piece.vertices - link.frame, piece.faces)
+                files.patches.append(p.relative_to(folder).as_posix())
         out[link.name] = files
     return out

@@ -2,7 +2,10 @@
 
 Joint frames: the joint origin is the articulation origin with no rotation, the axis is the world
 axis (= the joint-frame axis), and the part link's meshes are stored relative to that origin, so
-q = 0 is the scanned state and the motion equals ``Articulation.move``. The ``<mujoco>`` block keeps
+q = 0 is the scanned state and the motion equals ``Articulation.move``. The static background
+collides through convex planar patches: PyBullet ignores ``concave="yes"`` on a non-root link and
+MuJoCo convexifies every mesh, so one triangle-mesh collider became the room's solid hull (measured:
+a dropped ball was expelled through the floor). The ``<mujoco>`` block keeps
 visuals and the static bodies when MuJoCo imports this URDF.
 """
 
@@ -48,8 +51,7 @@ def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
     out += ['  <link name="world"/>']
     for link in model.links:
         f = files[link.name]
-        attrs = ' concave="yes"' if link.static_mesh is not None else ""
-        out.append(f'  <link name="{link.name}"{attrs}>')
+        out.append(f'  <link name="{link.name}">')
         out += _inertial(link)
         for k, vis in enumerate(f.visuals):
             out += [
@@ -58,7 +60,7 @@ def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
                 f'      <geometry><mesh filename="{prefix}{vis}"/></geometry>',
                 "    </visual>",
             ]
-        cols = ([f.static] if f.static else []) + f.collisions
+        cols = f.patches + f.collisions
         for k, col in enumerate(cols):
             out += [
                 f'    <collision name="{link.name}_collision_{k}">',

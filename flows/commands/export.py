@@ -1,0 +1,35 @@
+"""``react3d export OUT``: re-export a converted scene (its scene.json) to URDF / USD / MJCF without recomputing."""
+
+from __future__ import annotations
+
+import argparse
+
+HELP = "Export a converted scene (OUT/scene.json) to simulator formats: URDF, USD, MJCF (textures, collisions, inertia)."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("out", help="Output folder of a conversion (holds scene.json), or the scene.json itself.")
+    p.add_argument("--formats", default="urdf,usd,mjcf", help="Comma-separated formats (urdf, usd, mjcf).")
+    p.add_argument("--config", default=None, help="Pipeline config JSON; its 'export' section is used.")
+    p.add_argument("--ros-package", action="store_true", help="Also write a ROS 2 description package (package:// paths).")
+    p.add_argument("--texel-per-m", type=float, default=None, help="Texture budget override (texels per metre).")
+
+
+def run(args: argparse.Namespace) -> int:
+    from react3d_core.config import PipelineConfig
+    from react3d_core.errors import ConfigError
+    from react3d_core.export import export_scene
+
+    cfg = PipelineConfig.from_file(args.config).export if args.config else PipelineConfig().export
+    updates: dict = {}
+    if args.ros_package:
+        updates["ros_package"] = True
+    if args.texel_per_m is not None:
+        if args.texel_per_m <= 0:
+            raise ConfigError("--texel-per-m must be > 0")
+        updates["texel_per_m"] = args.texel_per_m
+    cfg = cfg.model_copy(update=updates)
+    formats = tuple(f.strip().lower() for f in args.formats.split(",") if f.strip())
+    for fmt, path in export_scene(args.out, formats=formats, config=cfg).items():
+        print(f"{fmt}: {path}")
+    return 0
