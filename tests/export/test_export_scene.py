@@ -1,0 +1,110 @@
+"""export_scene end to end: manifest bookkeeping, round trip through the URDF importer, movable
+output folder, ROS package, the ``react3d export`` command and bad input."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from react3d_core.data import InteractiveScene
+from react3d_core.errors import InputError
+from react3d_core.export import export_scene, import_urdf
+
+
+def test_manifest_records_exports(exported: dict[str, Path]) -> None:
+    root = exported["urdf"].parents[2]
+    scene = InteractiveScene.load(root / "scene.json")
+    assert scene.exports == {"urdf": "export/urdf/scene.urdf", "usd": "export/usd/scene.usda", "mjcf": "export/mjcf/scene.xml"}
+    for fmt, rel in scene.exports.items():
+        assert (root / rel) == exported[fmt] and exported[fmt].is_file()
+    urdf_dir = exported["urdf"].parent
+    assert (urdf_dir / "display.launch.py").is_file() and (urdf_dir / "display.launch").is_file()
+    assert (urdf_dir / "meshes" / "drawer__part" / "visual_0.glb").is_file()
+    # one folder per visual: trimesh's fixed MTL/PNG names never collide
+    for link in ("background", "door__base", "door__part", "drawer__base", "drawer__part"):
+        assert (urdf_dir / "meshes" / link / "visual_0" / "material_0.png").is_file()
+
+
+def test_round_trip_urdf_to_articulations(exported: dict[str, Path]) -> None:
+    scene = InteractiveScene.load(exported["urdf"].parents[2] / "scene.json")
+    back = import_urdf(exported["urdf"])
+    assert set(back) == {o.object_id for o in scene.objects}
+    for obj in scene.objects:
+        a, b = obj.articulation, back[obj.object_id]
+        assert a.joint_type == b.joint_type
+        np.testing.assert_allclose(b.axis, a.axis, atol=1e-12)
+        np.testing.assert_allclose(b.origin, a.origin, atol=1e-12)
+        assert (b.lower, b.upper) == (a.lower, a.upper)
+        pts = np.random.default_rng(0).normal(size=(20, 3))
+        q = 0.5 * a.upper
+        np.testing.assert_allclose(b.move(pts, q), a.move(pts, q), atol=1e-12)
+
+
+def test_moved_export_folder_still_loads(exported: dict[str, Path], tmp_path: Path) -> None:
+    pb = pytest.importorskip("pybullet")
+    mujoco = pytest.importorskip("mujoco")
+    yourdfpy = pytest.importorskip("yourdfpy")
+    from react3d_core.export.usd_checks import check_usd
+
+    moved = tmp_path / "elsewhere" / "export"
+    shutil.copytree(exported["urdf"].parents[1], moved)
+    urdf = moved / "urdf" / "scene.urdf"
+    cid = pb.connect(pb.DIRECT)
+    try:
+        body = pb.loadURDF(str(urdf), useFixedBase=True, physicsClientId=cid)
+        shapes = [pb.getCollisionShapeData(body, j, physicsClientId=cid) for j in range(pb.getNumJoints(body, physicsClientId=cid))]
+        assert all(len(s) > 0 for s in shapes)
+        assert all(str(moved).encode() in s[0][4] for s in shapes)
+    finally:
+        pb.disconnect(cid)
+    model = mujoco.MjModel.from_xml_path(str(moved / "mjcf" / "scene.xml"))
+    assert model.njnt == 2 and model.ntex >= 5
+    robot = yourdfpy.URDF.load(str(urdf), load_meshes=True)
+    assert len(robot.scene.geometry) >= 6
+    assert check_usd(moved / "usd" / "scene.usda") == []
+
+
+def test_ros_package_uses_package_paths(exported: dict[str, Path]) -> None:
+    pkg = exported["urdf"].parent / "ros" / "test_room_description"
+    assert (pkg / "package.xml").is_file() and (pkg / "CMakeLists.txt").is_file()
+    root = ET.parse(pkg / "urdf" / "scene.urdf").getroot()
+    names = [m.get("filename") for m in root.iter("mesh")]
+    assert names and all(n.startswith("package://test_room_description/meshes/") for n in names)
+    for n in names:
+        assert (pkg / n[len("package://test_room_description/") :]).is_file()
+
+
+def test_export_command_reexports_selected_formats(scene_dir: Path, tmp_path: Path) -> None:
+    from flows.cli import main
+
+    d = tmp_path / "scene"
+    shutil.copytree(scene_dir, d)
+    assert main(["export", str(d), "--formats", "mjcf,urdf", "--texel-per-m", "50"]) == 0
+    assert (d / "export" / "mjcf" / "scene.xml").is_file() and (d / "export" / "urdf" / "scene.urdf").is_file()
+    assert not (d / "export" / "usd").exists()
+    assert set(json.loads((d / "scene.json").read_text())["exports"]) == {"urdf", "mjcf"}
+    assert main(["export", str(d), "--formats", "obj"]) == 2
+    assert main(["export", str(tmp_path / "missing")]) == 2
+
+
+def test_bad_limits_are_one_line_input_errors(scene_dir: Path, tmp_path: Path) -> None:
+    d = tmp_path / "scene"
+    shutil.copytree(scene_dir, d)
+    data = json.loads((d / "scene.json").read_text())
+    data["objects"][0]["articulation"]["lower"] = 0.2
+    (d / "scene.json").write_text(json.dumps(data))
+    with pytest.raises(InputError, match="lower <= 0 <= upper"):
+        export_scene(d / "scene.json", formats=("urdf",))
+    with pytest.raises(InputError, match="unknown export format"):
+        export_scene(d / "scene.json", formats=("fbx",))
+    (d / "meshes" / "door" / "part.ply").write_bytes(b"ply\nformat ascii 1.0\nend_header\n")
+    data["objects"][0]["articulation"]["lower"] = 0.0
+    (d / "scene.json").write_text(json.dumps(data))
+    with pytest.raises(InputError):
+        export_scene(d / "scene.json", formats=("urdf",))
+    assert not (d / "export" / "urdf").exists()  # nothing half-written

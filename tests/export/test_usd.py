@@ -1,0 +1,79 @@
+"""USD export: opens, validates, joint frames agree and match the articulation, textures bound."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from react3d_core.data import InteractiveScene
+from react3d_core.export.usd import align_x
+from react3d_core.export.usd_checks import check_usd, joint_axis_world, usd_validation_errors
+
+pxr = pytest.importorskip("pxr")
+
+
+@pytest.mark.parametrize("axis", [(1, 0, 0), (-1, 0, 0), (0, 0, 1), (0, -1, 0), (0.3, -0.4, 0.866), (-1, 1e-12, 0)])
+def test_align_x_maps_x_onto_axis(axis: tuple[float, float, float]) -> None:
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    R = align_x(a)
+    np.testing.assert_allclose(R @ [1, 0, 0], a, atol=1e-9)
+    np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-9)
+    assert np.linalg.det(R) == pytest.approx(1.0)
+
+
+def test_usd_stage_passes_validation_and_our_checks(exported: dict[str, Path]) -> None:
+    from pxr import Usd, UsdGeom, UsdPhysics
+
+    stage = Usd.Stage.Open(str(exported["usd"]))
+    assert UsdGeom.GetStageUpAxis(stage) == UsdGeom.Tokens.z
+    assert UsdGeom.GetStageMetersPerUnit(stage) == 1.0
+    assert UsdPhysics.GetStageKilogramsPerUnit(stage) == 1.0
+    assert usd_validation_errors(stage) == []
+    assert check_usd(exported["usd"]) == []
+    roots = [p for p in stage.Traverse() if p.HasAPI(UsdPhysics.ArticulationRootAPI)]
+    assert sorted(str(p.GetPath()) for p in roots) == ["/World/door", "/World/drawer"]
+    # no subdivision on scanned meshes
+    meshes = [UsdGeom.Mesh(p) for p in stage.Traverse() if p.IsA(UsdGeom.Mesh)]
+    assert meshes and all(m.GetSubdivisionSchemeAttr().Get() == "none" for m in meshes)
+
+
+def test_usd_joint_world_axis_and_limits_match_articulation(exported: dict[str, Path]) -> None:
+    from pxr import Usd, UsdPhysics
+
+    scene = InteractiveScene.load(exported["urdf"].parents[2] / "scene.json")
+    stage = Usd.Stage.Open(str(exported["usd"]))
+    for obj in scene.objects:
+        prim = stage.GetPrimAtPath(f"/World/{obj.object_id}/joint")
+        art = obj.articulation
+        origin, axis = joint_axis_world(stage, prim)
+        np.testing.assert_allclose(axis, art.axis, atol=1e-5)
+        if art.joint_type == "revolute":  # the origin matters only on the hinge line
+            d = origin - np.asarray(art.origin)
+            assert np.linalg.norm(d - np.dot(d, art.axis) * np.asarray(art.axis)) <= 1e-5
+            lim = UsdPhysics.RevoluteJoint(prim)
+            scale = 180 / np.pi
+        else:
+            lim = UsdPhysics.PrismaticJoint(prim)
+            scale = 1.0
+        assert lim.GetLowerLimitAttr().Get() == pytest.approx(art.lower * scale, abs=1e-4)
+        assert lim.GetUpperLimitAttr().Get() == pytest.approx(art.upper * scale, abs=1e-4)
+
+
+def test_check_usd_catches_misaligned_frames_and_triangle_colliders(exported: dict[str, Path], tmp_path: Path) -> None:
+    from pxr import Gf, Usd, UsdPhysics
+
+    d = tmp_path / "usd"
+    shutil.copytree(exported["usd"].parent, d)
+    stage = Usd.Stage.Open(str(d / "scene.usda"))
+    UsdPhysics.Joint(stage.GetPrimAtPath("/World/door/joint")).GetLocalPos1Attr().Set(Gf.Vec3f(0.1, 0, 0))
+    piece = stage.GetPrimAtPath("/World/drawer/part/collisions/piece_0")
+    UsdPhysics.MeshCollisionAPI(piece).GetApproximationAttr().Set("none")
+    UsdPhysics.MassAPI(stage.GetPrimAtPath("/World/drawer/part")).GetMassAttr().Set(0.0)
+    stage.GetRootLayer().Save()
+    problems = check_usd(d / "scene.usda")
+    assert any("frame origins differ" in p for p in problems)
+    assert any("triangle-mesh collider" in p for p in problems)
+    assert any("mass 0.0" in p for p in problems)
