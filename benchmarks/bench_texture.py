@@ -1,0 +1,115 @@
+"""Texture-baking benchmark: a ~1M-face room background and a part-sized mesh.
+
+    python3 benchmarks/bench_texture.py --faces 1000000 --json bench_texture.json
+
+Builds a room (floor, four walls, ceiling) of ~``--faces`` triangles with smooth vertex colours plus
+per-vertex noise, bakes it with the default ExportConfig (per-triangle cell atlas above
+``xatlas_max_faces``) and a 5k-face part with xatlas, then writes the OBJ+MTL+PNG. Reports wall
+times, texture sizes and the mean colour error at vertex positions (bilinear lookup, 0..255 units).
+Targets: background bake <= 60 s on 2 cores, mean error <= 3/255.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from react3d_core.atomic import write_json  # noqa: E402
+
+
+def room(n_faces: int, seed: int = 0):  # noqa: ANN201
+    """A 6 x 5 x 2.6 m box room of about ``n_faces`` triangles with smooth, noisy vertex colours."""
+    from react3d_core.data import TriMesh
+
+    rng = np.random.default_rng(seed)
+    sx, sy, sz = 6.0, 5.0, 2.6
+    planes = [  # origin, u, v
+        ((0, 0, 0), (sx, 0, 0), (0, sy, 0)), ((0, 0, sz), (0, sy, 0), (sx, 0, 0)),
+        ((0, 0, 0), (0, 0, sz), (sx, 0, 0)), ((0, sy, 0), (sx, 0, 0), (0, 0, sz)),
+        ((0, 0, 0), (0, sy, 0), (0, 0, sz)), ((sx, 0, 0), (0, 0, sz), (0, sy, 0)),
+    ]
+    area = 2 * (sx * sy + sx * sz + sy * sz)
+    verts, faces, off = [], [], 0
+    for o, u, v in planes:
+        o, u, v = (np.asarray(x, float) for x in (o, u, v))
+        frac = np.linalg.norm(u) * np.linalg.norm(v) / area
+        n = max(1, int(round(np.sqrt(n_faces * frac / 2))))
+        s = np.linspace(0, 1, n + 1)
+        a, b = np.meshgrid(s, s, indexing="ij")
+        verts.append(o + a.reshape(-1, 1) * u + b.reshape(-1, 1) * v)
+        idx = np.arange((n + 1) ** 2).reshape(n + 1, n + 1) + off
+        q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4)
+        faces.append(np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]))
+        off += (n + 1) ** 2
+    V = np.concatenate(verts)
+    V = V + rng.normal(scale=0.002, size=V.shape)
+    col = np.stack([128 + 90 * np.sin(2 * V[:, 0]), 128 + 90 * np.cos(3 * V[:, 1]), 60 + 60 * V[:, 2]], 1)
+    col = col + rng.normal(scale=8, size=col.shape)
+    return TriMesh(V, np.concatenate(faces), np.clip(np.round(col), 0, 255).astype(np.uint8))
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--faces", type=int, default=1_000_000)
+    p.add_argument("--part-faces", type=int, default=5000)
+    p.add_argument("--json", default=None)
+    a = p.parse_args(argv)
+
+    from react3d_core.config.export import ExportConfig
+    from react3d_core.texture import bake_texture, vertex_color_error, write_obj_folder
+
+    cfg = ExportConfig()
+    rows: dict[str, float | int | str] = {}
+    bg = room(a.faces)
+    rows["background faces"] = bg.n_faces
+    t = time.perf_counter()
+    tm = bake_texture(bg, cfg)
+    rows["background bake s"] = round(time.perf_counter() - t, 2)
+    rows["background method"] = tm.method
+    rows["background texture"] = f"{tm.image.shape[1]}x{tm.image.shape[0]}"
+    rows["background mean colour error /255"] = round(vertex_color_error(tm, bg), 3)
+    with tempfile.TemporaryDirectory() as d:
+        t = time.perf_counter()
+        write_obj_folder(tm, Path(d) / "bg")
+        rows["background OBJ+PNG write s"] = round(time.perf_counter() - t, 2)
+
+    import trimesh
+
+    from react3d_core.data import TriMesh
+
+    sub = max(1, int(np.ceil(np.log(a.part_faces / 20) / np.log(4))))
+    sphere = trimesh.creation.icosphere(subdivisions=sub, radius=0.3)
+    v = np.asarray(sphere.vertices)
+    part = TriMesh(v, sphere.faces, np.clip(128 + 300 * v, 0, 255).astype(np.uint8))
+    rows["part faces"] = part.n_faces
+    t = time.perf_counter()
+    ptm = bake_texture(part, cfg)
+    rows["part bake s"] = round(time.perf_counter() - t, 2)
+    rows["part method"] = ptm.method
+    rows["part texture"] = f"{ptm.image.shape[1]}x{ptm.image.shape[0]}"
+    rows["part mean colour error /255"] = round(vertex_color_error(ptm, part), 3)
+
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title="texture baking")
+    table.add_column("measure")
+    table.add_column("value", justify="right")
+    for k, val in rows.items():
+        table.add_row(k, str(val))
+    Console().print(table)
+    if a.json:
+        write_json(a.json, rows)
+    ok = float(rows["background bake s"]) <= 60 and float(rows["background mean colour error /255"]) <= 3
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
