@@ -93,9 +93,11 @@ def _visuals(stage, prim_path: str, link: Link, folder: Path) -> None:  # noqa: 
 
     for k, tm in enumerate(link.visuals):
         name = f"{link.name}_visual_{k}"
-        mesh = _define_mesh(stage, f"{prim_path}/{name}", tm.vertices - link.frame, tm.faces)
-        st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
-        st.Set(Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(tm.uv, np.float32)))
+        # scan topology (shared points) with face-varying st: UV seams need no duplicated points
+        _, first, inv = np.unique(tm.source_vertex, return_index=True, return_inverse=True)
+        mesh = _define_mesh(stage, f"{prim_path}/{name}", tm.vertices[first] - link.frame, inv.reshape(-1)[tm.faces])
+        st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.faceVarying)
+        st.Set(Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(tm.uv[tm.faces].reshape(-1, 2), np.float32)))
         rel = f"textures/{name}.png"
         _write_png(folder / rel, tm)
         UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(_material(stage, name, f"./{rel}"))

@@ -77,3 +77,22 @@ def test_check_usd_catches_misaligned_frames_and_triangle_colliders(exported: di
     assert any("frame origins differ" in p for p in problems)
     assert any("triangle-mesh collider" in p for p in problems)
     assert any("mass 0.0" in p for p in problems)
+
+
+def test_usd_visuals_keep_scan_topology_with_face_varying_uvs(exported: dict[str, Path], scene_dir: Path) -> None:
+    from pxr import Usd, UsdGeom
+
+    from react3d_core.data import load_mesh
+
+    stage = Usd.Stage.Open(str(exported["usd"]))
+    mesh = UsdGeom.Mesh(stage.GetPrimAtPath("/World/background/background_visual_0"))
+    scan = load_mesh(scene_dir / "meshes" / "background.ply")
+    points = np.asarray(mesh.GetPointsAttr().Get())
+    assert len(points) == scan.n_vertices
+    assert len(mesh.GetFaceVertexIndicesAttr().Get()) == 3 * scan.n_faces
+    st = UsdGeom.PrimvarsAPI(mesh).GetPrimvar("st")
+    assert st.GetInterpolation() == UsdGeom.Tokens.faceVarying
+    assert len(st.Get()) == 3 * scan.n_faces
+    # same triangles as the scan (as point sets)
+    idx = np.asarray(mesh.GetFaceVertexIndicesAttr().Get()).reshape(-1, 3)
+    np.testing.assert_allclose(np.sort(points[idx].sum(1), axis=0), np.sort(scan.vertices[scan.faces].sum(1), axis=0), atol=1e-5)
