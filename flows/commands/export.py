@@ -9,7 +9,7 @@ HELP = "Export a converted scene (OUT/scene.json) to simulator formats: URDF, US
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("out", help="Output folder of a conversion (holds scene.json), or the scene.json itself.")
-    p.add_argument("--formats", default="urdf,usd,mjcf", help="Comma-separated formats (urdf, usd, mjcf).")
+    p.add_argument("--formats", default=None, help="Comma-separated formats (urdf, usd, mjcf); default: the config's export.formats.")
     p.add_argument("--config", default=None, help="Pipeline config JSON; its 'export' section is used.")
     p.add_argument("--ros-package", action="store_true", help="Also write a ROS 2 description package (package:// paths).")
     p.add_argument("--texel-per-m", type=float, default=None, help="Texture budget override (texels per metre).")
@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
             raise ConfigError("--texel-per-m must be > 0")
         updates["texel_per_m"] = args.texel_per_m
     cfg = cfg.model_copy(update=updates)
-    formats = tuple(f.strip().lower() for f in args.formats.split(",") if f.strip())
+    formats = tuple(f.strip().lower() for f in args.formats.split(",") if f.strip()) if args.formats else cfg.formats
     for fmt, path in export_scene(args.out, formats=formats, config=cfg).items():
         print(f"{fmt}: {path}")
     return 0
