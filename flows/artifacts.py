@@ -1,0 +1,91 @@
+"""Prefect artifacts a user sees in the UI: progress, a per-scene summary, the report link, dataset tables."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from react3d_core.data.parts import InteractiveScene
+
+
+def _key(s: str) -> str:
+    """Artifact keys: lowercase letters, digits and dashes only."""
+    return re.sub(r"[^a-z0-9-]+", "-", s.lower()).strip("-")[:60] or "scene"
+
+
+class Progress:
+    """Progress per stage, to an optional hook (the CLI's bar) and a Prefect progress artifact."""
+
+    def __init__(self, hook: Callable[[str, int, int], None] | None) -> None:
+        self.hook = hook
+        self.totals: dict[str, int] = {}
+        self.done: dict[str, int] = {}
+        self._artifact = None
+        self._stages = ["perception", "segmentation", "articulation", "assembly", "export", "report"]
+        try:
+            from prefect.artifacts import create_progress_artifact
+
+            self._artifact = create_progress_artifact(0.0, description="REACT3D scene conversion")
+        except Exception:  # noqa: BLE001 - outside a flow run (tests of the body) there is nothing to update
+            self._artifact = None
+
+    def start(self, stage: str, total: int) -> None:
+        self.totals[stage], self.done[stage] = total, 0
+        if self.hook:
+            self.hook(stage, 0, total)
+
+    def advance(self, stage: str, n: int) -> None:
+        self.done[stage] = self.done.get(stage, 0) + n
+        if self.hook:
+            self.hook(stage, self.done[stage], self.totals.get(stage, 1))
+        if self._artifact is not None:
+            from prefect.artifacts import update_progress_artifact
+
+            idx = self._stages.index(stage) if stage in self._stages else 0
+            frac = (idx + self.done[stage] / max(self.totals.get(stage, 1), 1)) / len(self._stages)
+            try:
+                update_progress_artifact(self._artifact, min(100.0, 100.0 * frac))
+            except Exception:  # noqa: BLE001 - progress is cosmetic; never fail a conversion over it
+                pass
+
+
+def scene_summary_markdown(scene_id: str, manifest_path: str, html: str | None, timings: dict[str, float],
+                           metrics: dict[str, Any] | None, n_candidates: int = 0, n_rejected: int = 0) -> str:
+    m = InteractiveScene.load(manifest_path)
+    lines = [f"# {scene_id}", "", f"Manifest: `{manifest_path}`", ""]
+    if html:
+        lines += [f"Report: [{html}](file://{Path(html).resolve()})", ""]
+    types: dict[str, int] = {}
+    for o in m.objects:
+        types[o.articulation.joint_type] = types.get(o.articulation.joint_type, 0) + 1
+    lines += [f"Parts: **{len(m.objects)}** ({', '.join(f'{v} {k}' for k, v in sorted(types.items())) or 'none'}); "
+              f"candidates {n_candidates}, rejected by validation {n_rejected}", "",
+              "| part | type | axis | limits | cavity (m) |", "|---|---|---|---|---|"]
+    for o in m.objects:
+        a = o.articulation
+        lines.append(f"| {o.object_id} | {a.joint_type} | {tuple(round(x, 2) for x in a.axis)} | "
+                     f"[{a.lower:.2f}, {a.upper:.2f}] | {o.cavity_depth if o.cavity_depth is None else round(o.cavity_depth, 3)} |")
+    lines += ["", "| stage | seconds |", "|---|---|"] + [f"| {k} | {v:.2f} |" for k, v in timings.items()]
+    if metrics and "aggregate" in metrics:
+        lines += ["", "| τ | precision | recall | F1 | joint acc | OE (°) | MD (m) |", "|---|---|---|---|---|---|---|"]
+        for tau, r in metrics["aggregate"].items():
+            f = lambda x: "–" if x is None else f"{x:.3f}"  # noqa: E731
+            lines.append(f"| {tau} | {f(r['precision'])} | {f(r['recall'])} | {f(r['f1'])} | {f(r['joint_acc'])} | {f(r['oe'])} | {f(r['md'])} |")
+    return "\n".join(lines)
+
+
+def publish_scene_artifacts(scene_id: str, manifest_path: str, html: str | None, timings: dict[str, float],
+                            metrics: dict[str, Any] | None, n_candidates: int = 0, n_rejected: int = 0) -> None:
+    """Markdown summary + a link to report.html (no-ops outside a Prefect run)."""
+    try:
+        from prefect.artifacts import create_link_artifact, create_markdown_artifact
+
+        create_markdown_artifact(scene_summary_markdown(scene_id, manifest_path, html, timings, metrics, n_candidates, n_rejected),
+                                 key=f"scene-{_key(scene_id)}", description=f"REACT3D summary of {scene_id}")
+        if html:
+            create_link_artifact(f"file://{Path(html).resolve()}", link_text="report.html",
+                                 key=f"report-{_key(scene_id)}", description="self-contained viewer and report")
+    except Exception:  # noqa: BLE001 - artifacts are for the UI; a conversion never fails over them
+        pass

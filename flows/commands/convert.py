@@ -1,0 +1,27 @@
+"""``react3d convert SCENE --out OUT``: one scan -> interactive scene, with an embedded Prefect."""
+
+from __future__ import annotations
+
+import argparse
+
+from ._runconfig import add_pipeline_arguments
+
+HELP = "Convert one scan (ScanNet++ iPhone/DSLR, prepared, mesh + transforms.json) into an interactive scene."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("scene", help="Scene folder.")
+    p.add_argument("--out", required=True, help="Output folder (replaced atomically when the run finishes).")
+    add_pipeline_arguments(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    from rich.console import Console
+
+    from ._runconfig import pipeline_overrides, run_with_progress
+    from .summary import print_summary
+
+    cfg = pipeline_overrides(args)
+    manifest = run_with_progress(args.scene, args.out, cfg, f"converting {args.scene}")
+    print_summary(Console(), manifest)
+    return 0

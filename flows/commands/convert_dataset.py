@@ -1,0 +1,43 @@
+"""``react3d convert-dataset ROOT --out OUT``: every scene under ROOT; failures reported, never fatal."""
+
+from __future__ import annotations
+
+import argparse
+
+from ._runconfig import add_pipeline_arguments
+
+HELP = "Convert every scene folder under ROOT (or --scenes / --glob); ends with a table of succeeded/failed scenes."
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("root", help="Dataset folder with one sub-folder per scene.")
+    p.add_argument("--out", required=True, help="Output root: one folder per scene.")
+    p.add_argument("--scenes", nargs="*", default=None, help="Scene ids (sub-folder names).")
+    p.add_argument("--glob", default=None, help="Pattern on sub-folder names, e.g. '0a*'.")
+    p.add_argument("--concurrency", type=int, default=1, help="Scenes converted at the same time.")
+    add_pipeline_arguments(p)
+
+
+def run(args: argparse.Namespace) -> int:
+    from rich.console import Console
+    from rich.table import Table
+
+    from tasks import prefect_env
+
+    from ._runconfig import pipeline_overrides
+
+    prefect_env.configure()
+    from flows.convert_dataset import convert_dataset
+
+    cfg = pipeline_overrides(args)
+    console = Console()
+    with console.status("converting scenes (per-scene progress in the Prefect UI when a server is configured)"):
+        rows = convert_dataset(args.root, args.scenes, args.glob, args.out, cfg, args.concurrency)
+    t = Table(title=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
+    for c in ("scene", "status", "parts", "seconds", "error"):
+        t.add_column(c)
+    for r in rows:
+        t.add_row(r["scene"], "[green]ok[/green]" if r["status"] == "ok" else "[red]failed[/red]", str(r["parts"]),
+                  f"{r['seconds']:.1f}", r["error"])
+    console.print(t)
+    return 0 if all(r["status"] == "ok" for r in rows) else 1

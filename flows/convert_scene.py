@@ -1,0 +1,119 @@
+"""Flow ``convert_scene``: one scan -> interactive scene (manifest, meshes, URDF/USD/MJCF, report).
+
+Fan-out: perception per batch of frames (GPU-capped with the ``gpu`` tag for model backends) and
+articulation per candidate part; fan-in: fusion, assembly (dedup, cavities, limits, carving), export.
+Every compute task is cached by content (tasks/keys.py), so re-running a finished scene is cheap and a
+crashed run resumes from the last finished task.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from typing import Any
+
+from tasks import prefect_env
+
+prefect_env.configure()
+
+from prefect import flow  # noqa: E402
+from prefect.task_runners import ThreadPoolTaskRunner  # noqa: E402
+
+from react3d_core.config import PipelineConfig  # noqa: E402
+from tasks.articulation import articulate_part  # noqa: E402
+from tasks.assembly import assemble, export, publish  # noqa: E402
+from tasks.keys import stage_version  # noqa: E402
+from tasks.perception import perceive_frames  # noqa: E402
+from tasks.report import evaluate, finalize, report  # noqa: E402
+from tasks.scene import fingerprint_scene  # noqa: E402
+from tasks.segmentation import segment_scene  # noqa: E402
+
+from .artifacts import publish_scene_artifacts, Progress  # noqa: E402
+
+STAGE_MODULES = ("react3d_core.scene_io", "react3d_core.perception", "react3d_core.perception.heuristic",
+                 "react3d_core.perception.oracle", "react3d_core.fusion", "react3d_core.articulation",
+                 "react3d_core.cavity", "react3d_core.dedup", "react3d_core.assembly", "react3d_core.texture",
+                 "react3d_core.export")
+
+# The CLI sets this to drive its progress bar: hook(stage, done, total).
+PROGRESS_HOOK: Callable[[str, int, int], None] | None = None
+
+
+def _chunks(items: list[str], n: int) -> list[list[str]]:
+    return [items[i:i + n] for i in range(0, len(items), n)]
+
+
+@flow(name="react3d-convert-scene", task_runner=ThreadPoolTaskRunner(max_workers=4), persist_result=False)
+def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None = None) -> str:
+    """Convert the scan at ``scene_path`` into ``out_dir``; returns the manifest path (``scene.json``)."""
+    t_all = time.perf_counter()
+    cfg = PipelineConfig().with_overrides(config or {})
+    c = cfg.model_dump(mode="json")
+    frames_cfg = c["frames"]
+    prog = Progress(PROGRESS_HOOK)
+    timings: dict[str, float] = {}
+
+    t = time.perf_counter()
+    fp = fingerprint_scene(scene_path, frames_cfg)
+    timings["load"] = time.perf_counter() - t
+    sha = fp["sha256"]
+    ids = fp["frame_ids"]
+    batch = max(1, cfg.perception.batch_size)
+    prog.start("perception", len(ids))
+
+    t = time.perf_counter()
+    tags = ["gpu"] if cfg.perception.backend == "models" else []
+    futs = [perceive_frames.with_options(tags=tags).submit(scene_path, sha, frames_cfg, b, c["perception"])
+            for b in _chunks(ids, batch)]
+    perc = []
+    for f, b in zip(futs, _chunks(ids, batch)):
+        perc.append(f.result())
+        prog.advance("perception", len(b))
+    timings["perception"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    prog.start("segmentation", 1)
+    seg = segment_scene(scene_path, sha, frames_cfg, perc, c)
+    prog.advance("segmentation", 1)
+    timings["segmentation"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    prog.start("articulation", seg["n"])
+    afuts = [articulate_part.submit(scene_path, sha, frames_cfg, seg, i, perc, c) for i in range(seg["n"])]
+    parts = []
+    for f in afuts:
+        parts.append(f.result())
+        prog.advance("articulation", 1)
+    timings["articulation"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    prog.start("assembly", 1)
+    asm = assemble(scene_path, sha, frames_cfg, parts, c)
+    prog.advance("assembly", 1)
+    timings["assembly"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    formats = list(cfg.export.formats) if hasattr(cfg.export, "formats") else ["urdf", "usd", "mjcf"]
+    prog.start("export", 1)
+    exp = export(asm, c["export"], formats)
+    manifest = publish(exp, out_dir)
+    prog.advance("export", 1)
+    timings["export"] = time.perf_counter() - t
+
+    metrics = None
+    if fp["gt_dir"]:
+        t = time.perf_counter()
+        metrics = evaluate(manifest, fp["gt_dir"], c)
+        timings["evaluation"] = time.perf_counter() - t
+    timings["total"] = time.perf_counter() - t_all
+    versions = {m: stage_version(m) for m in STAGE_MODULES}
+    finalize(manifest, c, versions, timings)
+    t = time.perf_counter()
+    prog.start("report", 1)
+    html = report(manifest, scene_path, frames_cfg, metrics)
+    prog.advance("report", 1)
+    timings["report"] = time.perf_counter() - t
+    finalize(manifest, c, versions, timings)
+    publish_scene_artifacts(fp["scene_id"], manifest, html, timings, metrics,
+                            n_candidates=seg["n"], n_rejected=sum(p.get("kind") == "rejected" for p in parts))
+    return manifest

@@ -1,0 +1,99 @@
+"""Scene-level tasks after articulation: dedup + cavity + limits + carving (assembly), export, publish.
+
+Assembly and export write folders into the content store (``$REACT3D_CACHE/scenes/<hash>``), so a
+cached result stays complete whatever happens to the output folder; ``publish`` copies the final folder
+to the user's output atomically (never a half-written result).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import time
+from pathlib import Path
+from typing import Any
+
+from prefect import task
+
+from react3d_core.atomic import atomic_dir
+from react3d_core.config import ExportConfig, PipelineConfig
+
+from .keys import canonical, content_key, stage_version
+from .scene import scan_mesh, scene_input
+from .store import cache_root, get
+
+
+def _dir_for(stage: str, inputs: Any) -> Path:
+    sha = hashlib.sha256(json.dumps([stage, canonical(inputs)], sort_keys=True, default=str).encode()).hexdigest()
+    return cache_root() / "scenes" / sha[:2] / f"{stage}-{sha[:32]}"
+
+
+def assemble_body(scene_path: str, scene_sha: str, frames_cfg: dict[str, Any], parts: list[dict[str, Any]],
+                  config: dict[str, Any]) -> dict[str, Any]:
+    from react3d_core.assembly import assemble_scene
+
+    t0 = time.perf_counter()
+    cfg = PipelineConfig.model_validate(config)
+    scene = scene_input(scene_path, frames_cfg)
+    versions = {m: stage_version(m) for m in ("react3d_core.articulation", "react3d_core.assembly",
+                                              "react3d_core.cavity", "react3d_core.dedup")}
+    out = _dir_for("assembly", [scene_sha, parts, config, versions])
+    arts = [get(h) for h in parts if h.get("kind") != "rejected"]
+    with atomic_dir(out) as tmp:
+        assemble_scene(scene, scan_mesh(str(scene.mesh_path)), arts, cfg, tmp)
+    return {"sha256": out.name, "path": str(out / "scene.json"), "kind": "assembled-scene",
+            "seconds": time.perf_counter() - t0}
+
+
+@task(name="assemble-scene", cache_key_fn=content_key("assembly", ("react3d_core.assembly", "react3d_core.cavity",
+                                                                 "react3d_core.dedup", "react3d_core.articulation")),
+      result_serializer="json", cache_result_in_memory=False)
+def assemble(scene_path: str, scene_sha: str, frames_cfg: dict[str, Any], parts: list[dict[str, Any]],
+             config: dict[str, Any]) -> dict[str, Any]:
+    """Deduplicate, add cavities and limits, carve the background; a manifest folder in the store."""
+    return assemble_body(scene_path, scene_sha, frames_cfg, parts, config)
+
+
+def export_body(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: list[str]) -> dict[str, Any]:
+    from react3d_core.export import export_scene
+
+    t0 = time.perf_counter()
+    src = Path(assembled["path"]).parent
+    out = _dir_for("export", [assembled, export_cfg, formats, stage_version("react3d_core.export"),
+                              stage_version("react3d_core.texture")])
+    with atomic_dir(out) as tmp:
+        shutil.copytree(src, tmp, dirs_exist_ok=True)
+        export_scene(tmp / "scene.json", tuple(formats), ExportConfig.model_validate(export_cfg))
+    return {"sha256": out.name, "path": str(out / "scene.json"), "kind": "exported-scene",
+            "seconds": time.perf_counter() - t0}
+
+
+@task(name="export-scene", cache_key_fn=content_key("export", ("react3d_core.export", "react3d_core.texture")),
+      result_serializer="json", cache_result_in_memory=False)
+def export(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: list[str]) -> dict[str, Any]:
+    """URDF / USD / MJCF with textures and collisions, in the store."""
+    return export_body(assembled, export_cfg, formats)
+
+
+def publish_body(result: dict[str, Any], out_dir: str) -> str:
+    """Copy the finished folder to ``out_dir`` as a whole (atomic rename); returns the manifest path."""
+    from react3d_core.data.parts import InteractiveScene
+
+    src = Path(result["path"]).parent
+    out = Path(out_dir).resolve()
+    manifest = InteractiveScene.load(src / "scene.json")
+    mesh = Path(manifest.input_mesh)
+    mesh = mesh if mesh.is_absolute() else (src / mesh).resolve()
+    with atomic_dir(out) as tmp:
+        shutil.copytree(src, tmp, dirs_exist_ok=True)
+        # the scan mesh stays where it is: re-point the manifest's reference from the new folder
+        rel = os.path.relpath(mesh, out)
+        manifest.model_copy(update={"input_mesh": rel}).save(tmp / "scene.json")
+    return str(out / "scene.json")
+
+
+@task(name="publish", persist_result=False)
+def publish(result: dict[str, Any], out_dir: str) -> str:
+    return publish_body(result, out_dir)
