@@ -35,6 +35,16 @@ STAGE_MODULES = ("react3d_core.scene_io", "react3d_core.perception", "react3d_co
                  "react3d_core.cavity", "react3d_core.dedup", "react3d_core.assembly", "react3d_core.texture",
                  "react3d_core.export")
 
+# Each task gets only the config sections it depends on, so its cache key changes exactly when they do.
+SEGMENTATION_KEYS = ("frames", "perception", "fusion", "topk", "clip")
+ARTICULATION_KEYS = ("frames", "perception", "topk", "articulation")
+ASSEMBLY_KEYS = ("frames", "articulation", "limits", "cavity", "dedup", "assembly")
+
+
+def config_sections(c: dict[str, Any], keys: tuple[str, ...]) -> dict[str, Any]:
+    return {k: c[k] for k in keys if k in c}
+
+
 # The CLI sets this to drive its progress bar: hook(stage, done, total).
 PROGRESS_HOOK: Callable[[str, int, int], None] | None = None
 
@@ -73,13 +83,14 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
 
     t = time.perf_counter()
     prog.start("segmentation", 1)
-    seg = segment_scene(scene_path, sha, frames_cfg, perc, c)
+    seg = segment_scene(scene_path, sha, frames_cfg, perc, config_sections(c, SEGMENTATION_KEYS))
     prog.advance("segmentation", 1)
     timings["segmentation"] = time.perf_counter() - t
 
     t = time.perf_counter()
     prog.start("articulation", seg["n"])
-    afuts = [articulate_part.submit(scene_path, sha, frames_cfg, seg, i, perc, c) for i in range(seg["n"])]
+    ac = config_sections(c, ARTICULATION_KEYS)
+    afuts = [articulate_part.submit(scene_path, sha, frames_cfg, seg, i, perc, ac) for i in range(seg["n"])]
     parts = []
     for f in afuts:
         parts.append(f.result())
@@ -88,12 +99,12 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
 
     t = time.perf_counter()
     prog.start("assembly", 1)
-    asm = assemble(scene_path, sha, frames_cfg, parts, c)
+    asm = assemble(scene_path, sha, frames_cfg, parts, config_sections(c, ASSEMBLY_KEYS))
     prog.advance("assembly", 1)
     timings["assembly"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    formats = list(cfg.export.formats) if hasattr(cfg.export, "formats") else ["urdf", "usd", "mjcf"]
+    formats = list(cfg.export.formats)
     prog.start("export", 1)
     exp = export(asm, c["export"], formats)
     manifest = publish(exp, out_dir)

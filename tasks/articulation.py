@@ -19,7 +19,7 @@ def articulate_body(scene_path: str, frames_cfg: dict[str, Any], candidates: dic
     from react3d_core.articulation import articulate_candidate
 
     t0 = time.perf_counter()
-    cfg = PipelineConfig.model_validate(config)
+    cfg = PipelineConfig().with_overrides(config)
     scene = scene_input(scene_path, frames_cfg)
     cand = get(candidates)[index]
     views = {v.frame_id for v in cand.top_views}

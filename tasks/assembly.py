@@ -35,7 +35,7 @@ def assemble_body(scene_path: str, scene_sha: str, frames_cfg: dict[str, Any], p
     from react3d_core.assembly import assemble_scene
 
     t0 = time.perf_counter()
-    cfg = PipelineConfig.model_validate(config)
+    cfg = PipelineConfig().with_overrides(config)
     scene = scene_input(scene_path, frames_cfg)
     versions = {m: stage_version(m) for m in ("react3d_core.articulation", "react3d_core.assembly",
                                               "react3d_core.cavity", "react3d_core.dedup")}

@@ -19,7 +19,7 @@ def segment_body(scene_path: str, frames_cfg: dict[str, Any], perception: list[d
     from react3d_core.fusion import segment_parts
 
     t0 = time.perf_counter()
-    cfg = PipelineConfig.model_validate(config)
+    cfg = PipelineConfig().with_overrides(config)
     scene = scene_input(scene_path, frames_cfg)
     masks: dict[str, list] = {}
     for h in perception:

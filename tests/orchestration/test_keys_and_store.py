@@ -1,0 +1,105 @@
+"""Cache keys from content, the pickle-free store, retry decisions, OOM batch splitting."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from react3d_core.data.masks import ArticulationPrediction, Mask2D
+from react3d_core.data.mesh import TriMesh
+from react3d_core.errors import InputError
+from tasks import serialize, store
+from tasks.keys import content_key
+from tasks.perception import split_on_oom
+from tasks.retry import TransientError, is_transient
+
+
+def test_serialize_round_trip_models_dataclasses_arrays() -> None:
+    m = Mask2D(frame_id="f1", mask=np.eye(4, dtype=bool), box=(0.0, 0.0, 3.0, 3.0))
+    p = ArticulationPrediction(frame_id="f1", mask=np.ones((2, 2), bool), joint_type="revolute", axis_cam=(0.0, 0.0, 1.0))
+    mesh = TriMesh(np.zeros((3, 3)), np.array([[0, 1, 2]]))
+    obj = {"masks": {"f1": [m]}, "preds": [p], "mesh": mesh, "t": (1, "a"), "n": np.int64(3)}
+    back = serialize.loads(serialize.dumps(obj))
+    assert back["masks"]["f1"][0].frame_id == "f1" and (back["masks"]["f1"][0].mask == m.mask).all()
+    assert back["masks"]["f1"][0].box == (0.0, 0.0, 3.0, 3.0)
+    assert back["preds"][0].axis_cam == (0.0, 0.0, 1.0)
+    assert (back["mesh"].faces == mesh.faces).all() and back["t"] == (1, "a") and back["n"] == 3
+
+
+def test_serialize_refuses_foreign_classes() -> None:
+    class Foreign:
+        pass
+
+    with pytest.raises(TypeError):
+        serialize.dumps(Foreign())
+    bad = serialize.dumps({"x": 1}).replace(b"x", b"x")  # a valid file still loads
+    assert serialize.loads(bad) == {"x": 1}
+
+
+def test_store_handles_are_content_addressed(tmp_path, monkeypatch) -> None:  # noqa: ANN001
+    monkeypatch.setenv("REACT3D_CACHE", str(tmp_path))
+    a = store.put({"v": np.arange(5)}, "x")
+    b = store.put({"v": np.arange(5)}, "x")
+    assert a == b and a["path"].startswith(str(tmp_path))
+    assert (store.get(a)["v"] == np.arange(5)).all()
+    (tmp_path / "objects" / a["sha256"][:2] / f"{a['sha256']}.npz").unlink()
+    with pytest.raises(InputError, match="cache clean"):
+        store.get(a)
+
+
+def test_keys_ignore_paths_and_follow_content_and_version(monkeypatch) -> None:  # noqa: ANN001
+    import tasks.keys as keys
+
+    k = content_key("seg", ("react3d_core.fusion",))
+    h1 = {"sha256": "abc", "path": "/run1/x.npz"}
+    h2 = {"sha256": "abc", "path": "/run2/x.npz"}
+    base = k(None, {"scene_path": "/a", "handle": h1, "config": {"fusion": {"x": 1}}})
+    assert base == k(None, {"scene_path": "/b", "handle": h2, "config": {"fusion": {"x": 1}}})
+    assert base != k(None, {"scene_path": "/a", "handle": {"sha256": "abd", "path": "/run1/x.npz"}, "config": {"fusion": {"x": 1}}})
+    assert base != k(None, {"scene_path": "/a", "handle": h1, "config": {"fusion": {"x": 2}}})
+    monkeypatch.setattr(keys, "stage_version", lambda m: "999")
+    assert base != k(None, {"scene_path": "/a", "handle": h1, "config": {"fusion": {"x": 1}}})
+
+
+def test_config_sections_isolate_stages() -> None:
+    import copy
+
+    from flows.convert_scene import ARTICULATION_KEYS, ASSEMBLY_KEYS, SEGMENTATION_KEYS, config_sections
+    from react3d_core.config import PipelineConfig
+
+    a = PipelineConfig().model_dump(mode="json")
+    b = copy.deepcopy(a)
+    b["export"]["changed"] = True
+    c = copy.deepcopy(a)
+    c["fusion"]["changed"] = True
+    for keys in (SEGMENTATION_KEYS, ARTICULATION_KEYS, ASSEMBLY_KEYS):  # export is none of their business
+        assert config_sections(a, keys) == config_sections(b, keys)
+    assert config_sections(a, SEGMENTATION_KEYS) != config_sections(c, SEGMENTATION_KEYS)
+    assert config_sections(a, ASSEMBLY_KEYS) == config_sections(c, ASSEMBLY_KEYS)
+
+
+def test_transient_errors() -> None:
+    class OutOfMemoryError(RuntimeError):
+        pass
+
+    assert is_transient(OutOfMemoryError("CUDA out of memory"))
+    assert is_transient(TimeoutError()) and is_transient(TransientError("x"))
+    assert not is_transient(InputError("/x", "missing")) and not is_transient(ValueError("bug"))
+
+
+def test_oom_splits_batches() -> None:
+    calls = []
+
+    class OutOfMemoryError(RuntimeError):
+        pass
+
+    def fn(frames, images):  # noqa: ANN001, ANN202
+        calls.append(len(frames))
+        if len(frames) > 2:
+            raise OutOfMemoryError("CUDA out of memory")
+        return [f * 10 for f in frames]
+
+    assert split_on_oom(fn, [1, 2, 3, 4, 5], [None] * 5) == [10, 20, 30, 40, 50]
+    assert calls[0] == 5 and max(calls[1:]) <= 3
+    with pytest.raises(ValueError):
+        split_on_oom(lambda f, i: (_ for _ in ()).throw(ValueError("bug")), [1, 2], [None] * 2)
