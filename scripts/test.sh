@@ -9,5 +9,10 @@ if ! command -v chromium >/dev/null && command -v apt-get >/dev/null; then
   $SUDO apt-get update -qq || true
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium >/dev/null || echo "[test] chromium unavailable: browser tests will be skipped"
 fi
+if ! command -v docker-compose >/dev/null && ! docker compose version >/dev/null 2>&1 && command -v apt-get >/dev/null; then
+  echo "[test] installing docker-compose (validates docker-compose.yml; no engine needed) ..."
+  SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq docker-compose >/dev/null 2>&1 || echo "[test] docker-compose unavailable: compose validation skipped"
+fi
 export TMPDIR="${TMPDIR:-/tmp}"
 python3 -m pytest -n 2 --dist loadfile -q "$@"
