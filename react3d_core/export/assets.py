@@ -13,6 +13,7 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..texture import write_glb, write_obj_folder
+from ..texture.writers import format_rows
 from .model import SceneModel
 
 
@@ -26,10 +27,9 @@ class LinkFiles:
 
 def write_plain_obj(path: Path, vertices: np.ndarray, faces: np.ndarray) -> Path:
     """Geometry-only OBJ (no MTL), vectorized formatting."""
-    lines = ["v %.9g %.9g %.9g" % tuple(r) for r in np.asarray(vertices, float)]
-    lines += ["f %d %d %d" % tuple(r) for r in (np.asarray(faces, np.int64) + 1)]
+    text = format_rows("v %.9g %.9g %.9g\n", np.asarray(vertices, float)) + format_rows("f %d %d %d\n", np.asarray(faces, np.int64) + 1)
     with atomic_path(path) as tmp:
-        tmp.write_text("\n".join(lines) + "\n")
+        tmp.write_text(text)
     return path
 
 

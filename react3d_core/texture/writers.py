@@ -20,16 +20,41 @@ def _trimesh(tm: TexturedMesh, offset: np.ndarray | None = None):  # noqa: ANN20
     return trimesh.Trimesh(v, tm.faces, visual=visual, process=False)
 
 
-def write_obj_folder(tm: TexturedMesh, folder: str | Path, offset: np.ndarray | None = None) -> Path:
-    """Write ``folder/mesh.obj`` with ``material.mtl`` and ``material_0.png``; vertices minus ``offset``.
+def format_rows(fmt: str, rows: np.ndarray) -> str:
+    """``fmt`` applied to every row in one C-level ``%`` call (no per-row Python loop)."""
+    rows = np.asarray(rows)
+    if not len(rows):
+        return ""
+    return (fmt * len(rows)) % tuple(rows.ravel().tolist())
 
-    The folder is written whole (temp + rename) because trimesh names the MTL/PNG itself.
+
+def write_obj_folder(tm: TexturedMesh, folder: str | Path, offset: np.ndarray | None = None) -> Path:
+    """Write ``folder/mesh.obj`` + ``material.mtl`` + ``material_0.png`` (trimesh's names), atomically.
+
+    Positions are written once per scan vertex and UVs once per atlas vertex (``f v/vt``), so the
+    per-triangle atlas of a large scan does not triple the positions. Vertices are minus ``offset``.
     """
+    import cv2
+
     from ..atomic import atomic_dir
 
     folder = Path(folder)
+    _, first, inv = np.unique(tm.source_vertex, return_index=True, return_inverse=True)
+    v = tm.vertices[first] - (0.0 if offset is None else np.asarray(offset, float))
+    fv = inv.reshape(-1)[tm.faces] + 1
+    ft = np.asarray(tm.faces, np.int64) + 1
+    corners = np.stack([fv, ft], -1).reshape(len(tm.faces), 6)
     with atomic_dir(folder) as tmp:
-        _trimesh(tm, offset).export(tmp / "mesh.obj", include_normals=False)
+        with open(tmp / "mesh.obj", "w") as fh:
+            fh.write("# REACT3D baked mesh\nmtllib material.mtl\nusemtl material_0\n")
+            fh.write(format_rows("v %.7g %.7g %.7g\n", v))
+            fh.write(format_rows("vt %.7g %.7g\n", tm.uv))
+            fh.write(format_rows("f %d/%d %d/%d %d/%d\n", corners))
+        (tmp / "material.mtl").write_text(
+            "newmtl material_0\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd material_0.png\n"
+        )
+        if not cv2.imwrite(str(tmp / "material_0.png"), np.ascontiguousarray(tm.image[..., ::-1])):
+            raise OSError(f"cannot write {folder / 'material_0.png'}")
     return folder / "mesh.obj"
 
 
