@@ -108,3 +108,25 @@ def test_bad_limits_are_one_line_input_errors(scene_dir: Path, tmp_path: Path) -
     with pytest.raises(InputError):
         export_scene(d / "scene.json", formats=("urdf",))
     assert not (d / "export" / "urdf").exists()  # nothing half-written
+
+
+def test_cell_atlas_path_loads_in_simulators(scene_dir: Path, tmp_path: Path) -> None:
+    """Large scans take the per-triangle atlas (OBJ with shared positions and per-corner UVs)."""
+    pb = pytest.importorskip("pybullet")
+    mujoco = pytest.importorskip("mujoco")
+    from react3d_core.config.export import ExportConfig
+
+    d = tmp_path / "scene"
+    shutil.copytree(scene_dir, d)
+    out = export_scene(d, formats=("urdf", "mjcf"), config=ExportConfig(xatlas_max_faces=1, texel_per_m=50, write_glb=False))
+    obj = out["urdf"].parent / "meshes" / "background" / "visual_0" / "mesh.obj"
+    text = obj.read_text()
+    assert text.count("\nv ") == 13 * 13 + 9 * 9 and " 1/" in text  # scan positions once, UVs per corner
+    model = mujoco.MjModel.from_xml_path(str(out["mjcf"]))
+    assert model.ntex >= 5
+    cid = pb.connect(pb.DIRECT)
+    try:
+        body = pb.loadURDF(str(out["urdf"]), useFixedBase=True, physicsClientId=cid)
+        assert pb.getNumJoints(body, physicsClientId=cid) == 5
+    finally:
+        pb.disconnect(cid)
