@@ -193,7 +193,6 @@ def test_mujoco_rollout_and_ball_in_drawer(exported: dict[str, Path], tmp_path: 
     model = mujoco.MjModel.from_xml_path(str(exported["mjcf"]))
     data = mujoco.MjData(model)
     names = [f"{k}__part" for k in JOINTS]
-    start = {n: mj_part_pose(mujoco, model, data, n) for n in names}
     mujoco.mj_forward(model, data)
     start = {n: mj_part_pose(mujoco, model, data, n) for n in names}
     for _ in range(1000):  # 2 s
