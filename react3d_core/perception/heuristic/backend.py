@@ -1,0 +1,159 @@
+"""The heuristic backend's five calls, all answered from fronts found on the scan mesh (no weights).
+
+Per frame, the scan mesh is rendered (at half resolution, upsampled) into a front-id image; masks,
+point-prompt answers and articulation predictions are read off it. Renders are cached per frame so
+the segmenter, the point segmenter and the predictor share them.
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+from collections.abc import Sequence
+
+import cv2
+import numpy as np
+
+from ...data.frames import Frame, SceneInput
+from ...data.masks import ArticulationPrediction, Mask2D
+from ...data.mesh import TriMesh, load_mesh
+from ...raster import Rasterizer
+from .facets import planar_facets
+from .fronts import Front, FrontRules, find_fronts
+
+OPENABLE_TAGS = ("cabinet", "drawer", "door", "wardrobe", "dresser", "refrigerator", "oven", "dishwasher")
+MIN_MASK_PX = 150
+
+
+class HeuristicModel:
+    """Facets, fronts and per-frame renders of one scene."""
+
+    def __init__(self, scene: SceneInput, rules: FrontRules = FrontRules(), scale: float = 0.5, n_probe: int = 24) -> None:
+        self.scene = scene
+        self.mesh: TriMesh = load_mesh(scene.mesh_path)
+        self.raster = Rasterizer(self.mesh)
+        self.scale = scale
+        self.facets = planar_facets(self.mesh)
+        self._cache: OrderedDict[str, tuple[np.ndarray, np.ndarray]] = OrderedDict()
+        visible = self._visible_facets(n_probe)
+        cams = np.array([f.c2w[:3, 3] for f in scene.frames])
+        self.fronts: list[Front] = find_fronts(self.mesh, self.facets, visible, cams.mean(0), rules)
+        self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
+        for i, fr in enumerate(self.fronts):
+            self.face_front[fr.faces] = i
+
+    def _visible_facets(self, n_probe: int) -> np.ndarray:
+        idx = np.unique(np.linspace(0, len(self.scene.frames) - 1, min(n_probe, len(self.scene.frames))).round().astype(int))
+        px = np.zeros(self.facets.n, np.int64)
+        seen = np.zeros(self.facets.n, np.int64)
+        for i in idx:
+            f = self.scene.frames[i]
+            intr = f.intrinsics.scaled(max(1, f.intrinsics.width // 4), max(1, f.intrinsics.height // 4))
+            ids = self.raster.render(intr.K, f.c2w, intr.width, intr.height).face_ids
+            lab = self.facets.labels[ids[ids >= 0]]
+            c = np.bincount(lab, minlength=self.facets.n)
+            px += c
+            seen += c >= 4
+        return (px >= 40) & (seen >= 2)
+
+    def render(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
+        """(front id, face id) images at the frame's RGB size; -1 = none."""
+        hit = self._cache.get(frame.frame_id)
+        if hit is not None:
+            self._cache.move_to_end(frame.frame_id)
+            return hit
+        W, H = frame.intrinsics.width, frame.intrinsics.height
+        intr = frame.intrinsics.scaled(max(1, round(W * self.scale)), max(1, round(H * self.scale)))
+        ids = self.raster.render(intr.K, frame.c2w, intr.width, intr.height).face_ids
+        ids = cv2.resize(ids, (W, H), interpolation=cv2.INTER_NEAREST)
+        fronts = self.face_front[np.where(ids >= 0, ids, self.mesh.n_faces)]
+        self._cache[frame.frame_id] = (fronts, ids)
+        if len(self._cache) > 16:
+            self._cache.popitem(last=False)
+        return fronts, ids
+
+    def masks(self, frame: Frame) -> list[tuple[int, np.ndarray]]:
+        fronts, _ = self.render(frame)
+        counts = np.bincount(fronts[fronts >= 0].ravel(), minlength=len(self.fronts))
+        return [(int(k), fronts == k) for k in np.flatnonzero(counts >= MIN_MASK_PX)]
+
+
+def _box(mask: np.ndarray) -> tuple[float, float, float, float]:
+    ys, xs = np.nonzero(mask)
+    return float(xs.min()), float(ys.min()), float(xs.max()), float(ys.max())
+
+
+class HeuristicTagger:
+    def __init__(self, model: HeuristicModel) -> None:
+        self.model = model
+
+    def tag(self, frames: Sequence[Frame], images: Sequence[np.ndarray]) -> list[list[str]]:
+        return [["cabinet", "drawer", "door"] if self.model.masks(f) else [] for f in frames]
+
+
+class KeepOpenable:
+    """Tag filter: keeps the tags of a fixed openable vocabulary (always 'door')."""
+
+    def filter(self, tags: Sequence[str]) -> list[str]:
+        return sorted({t for t in tags if t in OPENABLE_TAGS} | {"door"})
+
+
+class HeuristicSegmenter:
+    def __init__(self, model: HeuristicModel) -> None:
+        self.model = model
+
+    def segment(self, frames: Sequence[Frame], images: Sequence[np.ndarray], phrases: Sequence[str]) -> list[list[Mask2D]]:
+        out = []
+        for f in frames:
+            out.append([Mask2D(frame_id=f.frame_id, label=self.model.fronts[k].kind or "openable", score=0.9, mask=m, box=_box(m))
+                        for k, m in self.model.masks(f)])
+        return out
+
+
+class HeuristicPointSegmenter:
+    """The front (else the planar facet) under most positive points."""
+
+    def __init__(self, model: HeuristicModel) -> None:
+        self.model = model
+
+    def segment_points(self, frame: Frame, image: np.ndarray, points: np.ndarray, labels: np.ndarray) -> Mask2D:
+        fronts, ids = self.model.render(frame)
+        H, W = fronts.shape
+        pos = np.asarray(points, float)[np.asarray(labels) > 0]
+        if len(pos) == 0:
+            return Mask2D(frame_id=frame.frame_id, mask=np.zeros((H, W), bool), score=0.0)
+        x = np.clip(np.round(pos[:, 0]).astype(int), 0, W - 1)
+        y = np.clip(np.round(pos[:, 1]).astype(int), 0, H - 1)
+        under = fronts[y, x]
+        if (under >= 0).any():
+            k = np.bincount(under[under >= 0]).argmax()
+            m = fronts == k
+        else:
+            fid = ids[y, x]
+            fid = fid[fid >= 0]
+            if len(fid) == 0:
+                return Mask2D(frame_id=frame.frame_id, mask=np.zeros((H, W), bool), score=0.0)
+            lab = self.model.facets.labels
+            k = np.bincount(lab[fid]).argmax()
+            m = (ids >= 0) & (lab[np.maximum(ids, 0)] == k)
+        return Mask2D(frame_id=frame.frame_id, mask=m, score=0.8, box=_box(m) if m.any() else None)
+
+
+class HeuristicArticulation:
+    def __init__(self, model: HeuristicModel) -> None:
+        self.model = model
+
+    def predict(self, frames: Sequence[Frame], images: Sequence[np.ndarray]) -> list[list[ArticulationPrediction]]:
+        out = []
+        for f in frames:
+            w2c = f.w2c
+            preds = []
+            for k, m in self.model.masks(f):
+                a = self.model.fronts[k].articulation
+                if a is None:
+                    continue
+                axis = w2c[:3, :3] @ np.asarray(a.axis)
+                origin = w2c[:3, :3] @ np.asarray(a.origin) + w2c[:3, 3]
+                preds.append(ArticulationPrediction(frame_id=f.frame_id, mask=m, joint_type=a.joint_type,
+                                                    axis_cam=tuple(axis), origin_cam=tuple(origin), score=0.7))
+            out.append(preds)
+        return out
