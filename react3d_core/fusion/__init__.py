@@ -1,0 +1,36 @@
+"""Segmentation stage: multi-view 2D->3D mask fusion, top-k views, re-segmentation, clipping.
+
+Each sub-step is callable on its own (the Prefect layer lifts frames as separate tasks):
+``lift_masks`` (per frame) -> ``fuse_proposals`` -> ``select_top_views`` -> ``resegment`` ->
+``clip_part``; ``segment_parts`` runs them all.
+"""
+
+from .clip import clip_part, ransac_plane
+from .connectivity import largest_component, weld_labels
+from .lift import FrameLift, fill_holes, lift_masks
+from .proposals import FusionMesh, Proposal, fuse_proposals, prepare_fusion_mesh
+from .reseg import point_prompts, resegment
+from .segment import lift_frames, segment_parts
+from .topk import select_top_views
+
+STAGE_VERSION = "1"
+
+__all__ = [
+    "STAGE_VERSION",
+    "FrameLift",
+    "FusionMesh",
+    "Proposal",
+    "clip_part",
+    "fill_holes",
+    "fuse_proposals",
+    "largest_component",
+    "lift_frames",
+    "lift_masks",
+    "point_prompts",
+    "prepare_fusion_mesh",
+    "ransac_plane",
+    "resegment",
+    "segment_parts",
+    "select_top_views",
+    "weld_labels",
+]

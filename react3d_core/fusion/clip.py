@@ -1,0 +1,89 @@
+"""Movable-part clipping: keep the slab in front of the part's front plane (handles included).
+
+Why: a whole-object mask (door + carcass frame) back-projects onto the carcass sides and top too.
+The front of a door or drawer is the dominant near-vertical plane of the segmented mesh; geometry
+more than ``keep_behind_m`` behind it (seen from the segmenting view) is not part of the slab.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..config import ClipConfig
+from ..data.mesh import TriMesh
+
+MAX_POINTS = 4000
+
+
+def face_geometry(mesh: TriMesh, face_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Centroids, unit normals and areas of ``face_ids``."""
+    tri = mesh.vertices[mesh.faces[face_ids]]
+    cr = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    nrm = np.linalg.norm(cr, axis=1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        n = np.where(nrm[:, None] > 0, cr / nrm[:, None], 0.0)
+    return tri.mean(1), n, 0.5 * nrm
+
+
+def ransac_plane(points: np.ndarray, weights: np.ndarray, config: ClipConfig, view_dir: np.ndarray | None = None) -> tuple[np.ndarray, float] | None:
+    """Near-vertical plane (|n_z| <= max_abs_nz) with the most inlier weight; refined by least squares.
+
+    With ``view_dir`` the inlier weight is scaled by |cos| between the plane normal and the view, so
+    the front facing the camera wins over a carcass side panel of similar area.
+    """
+    if len(points) < 3:
+        return None
+    rng = np.random.default_rng(config.seed)
+    if len(points) > MAX_POINTS:
+        sel = rng.choice(len(points), MAX_POINTS, replace=False)
+        points, weights = points[sel], weights[sel]
+    idx = rng.integers(0, len(points), (config.ransac_iterations, 3))
+    a, b, c = points[idx[:, 0]], points[idx[:, 1]], points[idx[:, 2]]
+    n = np.cross(b - a, c - a)
+    ln = np.linalg.norm(n, axis=1)
+    ok = ln > 1e-9
+    n = n[ok] / ln[ok, None]
+    a = a[ok]
+    ok = np.abs(n[:, 2]) <= config.max_abs_nz
+    n, a = n[ok], a[ok]
+    if not len(n):
+        return None
+    d = -(n * a).sum(1)
+    score = ((np.abs(points @ n.T + d) < config.ransac_threshold_m) * weights[:, None]).sum(0)
+    if view_dir is not None:
+        score = score * np.abs(n @ view_dir)
+    best = int(np.argmax(score))
+    inl = np.abs(points @ n[best] + d[best]) < config.ransac_threshold_m
+    if inl.sum() >= 3:
+        c0 = np.average(points[inl], axis=0, weights=weights[inl] + 1e-12)
+        _, _, vt = np.linalg.svd((points[inl] - c0) * np.sqrt(weights[inl] + 1e-12)[:, None], full_matrices=False)
+        nn = vt[2]
+        if abs(nn[2]) <= config.max_abs_nz:
+            return nn, float(-nn @ c0)
+    return n[best], float(d[best])
+
+
+def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, config: ClipConfig) -> tuple[np.ndarray, np.ndarray | None, float | None]:
+    """Faces of the slab, and the plane (normal pointing away from the camera, offset) or None.
+
+    Faces whose centroid lies more than ``keep_behind_m`` behind the plane are dropped; everything in
+    front (handles) stays.
+    """
+    face_ids = np.asarray(face_ids, np.int64)
+    if not config.enabled or not len(face_ids):
+        return face_ids, None, None
+    cen, nrm, area = face_geometry(mesh, face_ids)
+    vert = np.abs(nrm[:, 2]) <= config.max_abs_nz
+    if not vert.any():
+        return face_ids, None, None
+    foot = np.average(cen[vert], axis=0, weights=area[vert] + 1e-12)
+    view = foot - np.asarray(camera_center, float)
+    plane = ransac_plane(cen[vert], area[vert], config, view / (np.linalg.norm(view) + 1e-12))
+    if plane is None:
+        return face_ids, None, None
+    n, d = plane
+    if n @ (foot - np.asarray(camera_center, float)) < 0:
+        n, d = -n, -d
+    s = cen @ n + d  # > 0: behind the plane, seen from the camera
+    keep = s <= config.keep_behind_m
+    return face_ids[keep], n, d

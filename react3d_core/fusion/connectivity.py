@@ -1,0 +1,85 @@
+"""Mesh connectivity that tolerates unwelded scans: weld close vertices, face adjacency, components.
+
+Scanned (and synthetic, per-object) meshes often repeat vertices along seams, so two faces are
+"connected" when they share a vertex after merging vertices closer than ``weld_m``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from ..data.mesh import TriMesh
+
+
+def weld_labels(vertices: np.ndarray, weld_m: float) -> np.ndarray:
+    """Label per vertex; vertices closer than ``weld_m`` (transitively) share a label."""
+    n = len(vertices)
+    if n == 0 or weld_m <= 0:
+        return np.arange(n)
+    pairs = cKDTree(vertices).query_pairs(weld_m, output_type="ndarray")
+    if not len(pairs):
+        return np.arange(n)
+    g = sparse.coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    return connected_components(g, directed=False)[1]
+
+
+def welded_faces(mesh: TriMesh, weld_m: float) -> np.ndarray:
+    """Faces re-indexed into welded vertex labels (M,3)."""
+    return weld_labels(mesh.vertices, weld_m)[mesh.faces]
+
+
+def edge_adjacency(faces: np.ndarray) -> np.ndarray:
+    """(E,2) pairs of faces sharing an edge (i < j), from faces over (welded) vertex ids."""
+    m = len(faces)
+    if m == 0:
+        return np.zeros((0, 2), np.int64)
+    e = np.sort(np.stack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]], 1).reshape(-1, 2), 1)
+    fid = np.repeat(np.arange(m), 3)
+    key = e[:, 0].astype(np.int64) * (int(faces.max()) + 1) + e[:, 1]
+    order = np.argsort(key, kind="stable")
+    key, fid = key[order], fid[order]
+    same = np.nonzero(key[1:] == key[:-1])[0]
+    a, b = fid[same], fid[same + 1]
+    keep = a != b
+    pairs = np.sort(np.stack([a[keep], b[keep]], 1), 1)
+    return np.unique(pairs, axis=0) if len(pairs) else np.zeros((0, 2), np.int64)
+
+
+def face_components(wfaces: np.ndarray, face_ids: np.ndarray) -> tuple[int, np.ndarray]:
+    """Connected components of the faces ``face_ids`` (shared welded vertex = connected)."""
+    face_ids = np.asarray(face_ids, np.int64)
+    if not len(face_ids):
+        return 0, np.zeros(0, np.int64)
+    v, inv = np.unique(wfaces[face_ids].ravel(), return_inverse=True)
+    nf, nv = len(face_ids), len(v)
+    rows = np.repeat(np.arange(nf), 3)
+    b = sparse.coo_matrix((np.ones(3 * nf, np.int8), (rows, nf + inv.ravel())), shape=(nf + nv, nf + nv))
+    n, lab = connected_components(b, directed=False)
+    lab = lab[:nf]
+    _, lab = np.unique(lab, return_inverse=True)
+    return int(lab.max()) + 1, lab
+
+
+def largest_component(mesh: TriMesh, wfaces: np.ndarray, face_ids: np.ndarray, attach_m: float = 0.0) -> np.ndarray:
+    """Faces of the largest (by area) component, plus components within ``attach_m`` of it.
+
+    Why the attachment: a handle modelled or scanned as a separate shell touching the door
+    surface shares no vertex with it, yet moves with it.
+    """
+    face_ids = np.unique(np.asarray(face_ids, np.int64))
+    n, lab = face_components(wfaces, face_ids)
+    if n <= 1:
+        return face_ids
+    tri = mesh.vertices[mesh.faces[face_ids]]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    big = int(np.argmax(np.bincount(lab, weights=area, minlength=n)))
+    keep = lab == big
+    if attach_m > 0:
+        tree = cKDTree(tri[keep].reshape(-1, 3))
+        d, _ = tree.query(tri[~keep].reshape(-1, 3), distance_upper_bound=attach_m)
+        near_comp = np.unique(lab[~keep][np.isfinite(d.reshape(-1, 3)).any(1)])
+        keep |= np.isin(lab, near_comp)
+    return face_ids[keep]

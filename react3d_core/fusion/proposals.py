@@ -1,0 +1,108 @@
+"""Lifted masks -> 3D part proposals: co-occurrence graph, Louvain, size and connectivity filters.
+
+Fusion may run on a decimated copy of the scan (``config.fusion.decimate_faces``): every scan face
+maps to the decimated face with the nearest centroid, lifted faces are mapped through it, and a
+community maps back to all scan faces whose nearest decimated face is in it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..config import PipelineConfig
+from ..data.mesh import TriMesh
+from .connectivity import edge_adjacency, largest_component, welded_faces
+from .graph import cooccurrence, face_graph, louvain, membership
+from .lift import FrameLift
+
+
+@dataclass
+class Proposal:
+    """A fused 3D proposal: scan faces (full resolution), Louvain resolution and support (masks)."""
+
+    proposal_id: int
+    face_ids: np.ndarray
+    resolution: float
+    support: int
+
+
+@dataclass
+class FusionMesh:
+    """The mesh fusion runs on, with the scan-face -> fusion-face map and welded connectivity."""
+
+    mesh: TriMesh
+    face_map: np.ndarray  # scan face -> fusion face
+    wfaces: np.ndarray  # fusion faces over welded vertex labels
+    adjacency: np.ndarray  # (E,2) edge-adjacent fusion faces
+
+    @property
+    def n_faces(self) -> int:
+        return self.mesh.n_faces
+
+
+def _centroids(mesh: TriMesh) -> np.ndarray:
+    return mesh.vertices[mesh.faces].mean(1)
+
+
+def decimate(mesh: TriMesh, target_faces: int) -> tuple[TriMesh, np.ndarray]:
+    """Quadric decimation (Open3D) to ``target_faces``; scan faces map to the nearest decimated centroid."""
+    m = mesh.to_open3d().simplify_quadric_decimation(int(target_faces))
+    small = TriMesh(np.asarray(m.vertices), np.asarray(m.triangles))
+    _, fmap = cKDTree(_centroids(small)).query(_centroids(mesh), workers=-1)
+    return small, fmap.astype(np.int64)
+
+
+def prepare_fusion_mesh(mesh: TriMesh, config: PipelineConfig) -> FusionMesh:
+    """Decimate when the scan is larger than ``decimate_faces``, weld, and build face adjacency."""
+    target = config.fusion.decimate_faces
+    if target is not None and mesh.n_faces > target:
+        small, fmap = decimate(mesh, target)
+    else:
+        small, fmap = mesh, np.arange(mesh.n_faces, dtype=np.int64)
+    wf = welded_faces(small, config.fusion.weld_m)
+    return FusionMesh(small, fmap, wf, edge_adjacency(wf))
+
+
+def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineConfig, fusion_mesh: FusionMesh | None = None) -> list[Proposal]:
+    """Co-occurrence graph of the lifted faces -> Louvain communities at each resolution -> proposals.
+
+    A community is kept when it has more than ``min_community_faces`` fusion faces; it is cut to its
+    largest connected component; communities found again at another resolution are merged.
+    """
+    fc = config.fusion
+    fm = fusion_mesh or prepare_fusion_mesh(mesh, config)
+    sets = [np.unique(fm.face_map[s]) for lf in lifts for s in lf.face_sets]
+    sets = [s for s in sets if len(s)]
+    if not sets:
+        return []
+    n = fm.n_faces
+    counts = cooccurrence(sets, n, fm.adjacency, fc.max_pairs_per_mask, fc.seed)
+    graph = face_graph(counts, fc.min_cooccurrence)
+    M = membership(sets, n)
+    support = np.asarray(M.sum(0)).ravel()
+    nodes = np.nonzero(support > 0)[0]
+    rng = np.random.default_rng(fc.seed)
+    sig = (M[:, nodes].T @ rng.random(M.shape[0])).astype(np.float64)
+    sig = np.round(sig * 1e9).astype(np.int64)  # equal mask sets -> equal signature
+    comms = louvain(graph, nodes, sig, fc.resolutions, fc.seed)
+    seen: list[np.ndarray] = []
+    out: list[Proposal] = []
+    for res, com in comms:
+        if len(com) <= fc.min_community_faces:
+            continue
+        com = largest_component(fm.mesh, fm.wfaces, com)
+        if len(com) <= fc.min_community_faces:
+            continue
+        if any(len(np.intersect1d(com, s, assume_unique=True)) / len(np.union1d(com, s)) > 0.95 for s in seen):
+            continue
+        seen.append(com)
+        in_com = np.zeros(n, bool)
+        in_com[com] = True
+        faces = np.nonzero(in_com[fm.face_map])[0]
+        sup = int(np.median(support[com]))
+        out.append(Proposal(len(out), faces, res, sup))
+    return out

@@ -1,0 +1,130 @@
+"""Re-segmentation: point prompts from a proposal's silhouette in its best view -> mask -> scan faces.
+
+Why: fused proposals are only as good as the co-occurrence graph (ragged, sometimes a fragment
+of the part); one clean mask in the best view, back-projected on the full-resolution scan, gives
+sharp part boundaries. Faces that view cannot see come from the other top-k views or the proposal.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import cv2
+import numpy as np
+
+from ..config import PipelineConfig
+from ..data.frames import Frame
+from ..data.masks import Mask2D
+from ..data.mesh import TriMesh
+from ..data.parts import TopView
+from ..errors import InputError
+from ..perception.interfaces import PointPromptSegmenter
+from ..camera import project
+from ..raster.rasterizer import RasterResult
+from .connectivity import largest_component
+from .lift import erode, fill_holes, resize_mask, scaled_px
+
+
+def point_prompts(silhouette: np.ndarray, n_pos: int = 3, n_neg: int = 4) -> tuple[np.ndarray, np.ndarray]:
+    """Positive points deep inside the silhouette (distance-transform peaks, spread apart) and
+    negative points just outside its bounding box (left, right, above, below). (N,2) px, labels 1/0."""
+    h, w = silhouette.shape
+    sil = silhouette.astype(np.uint8)
+    dt = cv2.distanceTransform(np.pad(sil, 1), cv2.DIST_L2, 5)[1:-1, 1:-1]
+    pts, lab = [], []
+    work = dt.copy()
+    for _ in range(n_pos):
+        y, x = np.unravel_index(int(np.argmax(work)), work.shape)
+        if work[y, x] <= 0:
+            break
+        pts.append((x, y))
+        lab.append(1)
+        r = max(2, int(dt[y, x]))
+        cv2.circle(work, (int(x), int(y)), r, 0, -1)
+    ys, xs = np.nonzero(silhouette)
+    if len(xs):
+        x0, x1, y0, y1 = xs.min(), xs.max(), ys.min(), ys.max()
+        mx, my = max(3, (x1 - x0) // 8), max(3, (y1 - y0) // 8)
+        cx, cy = (x0 + x1) // 2, (y0 + y1) // 2
+        cand = [(x0 - mx, cy), (x1 + mx, cy), (cx, y0 - my), (cx, y1 + my)][:n_neg]
+        for x, y in cand:
+            if 0 <= x < w and 0 <= y < h and not silhouette[y, x]:
+                pts.append((x, y))
+                lab.append(0)
+    return np.asarray(pts, float).reshape(-1, 2), np.asarray(lab, np.int64)
+
+
+def _image(frame: Frame) -> np.ndarray:
+    """The RGB image for the point segmenter (a black image when the file is unreadable: the
+    oracle and heuristic backends do not look at it)."""
+    from ..scene_io.images import frame_rgb
+
+    try:
+        return frame_rgb(frame)
+    except InputError:
+        return np.zeros((frame.intrinsics.height, frame.intrinsics.width, 3), np.uint8)
+
+
+def hidden_behind(mesh: TriMesh, frame: Frame, raster: RasterResult, mask: np.ndarray, slab_m: float) -> np.ndarray:
+    """Faces hidden from the view whose centroid projects inside ``mask`` and lies at most ``slab_m``
+    behind the visible surface there (the back and edges of a door or drawer front)."""
+    h, w = mask.shape
+    intr = frame.intrinsics if frame.intrinsics.width == w else frame.intrinsics.scaled(w, h)
+    cen = mesh.vertices[mesh.faces].mean(1)
+    uv, z = project(cen, intr.K, frame.w2c)
+    ok = (z > 0) & np.all(np.isfinite(uv), 1)
+    ui = np.full(len(z), -1)
+    vi = np.full(len(z), -1)
+    ui[ok], vi[ok] = np.round(uv[ok, 0]).astype(int), np.round(uv[ok, 1]).astype(int)
+    ok &= (ui >= 0) & (ui < w) & (vi >= 0) & (vi < h)
+    idx = np.nonzero(ok)[0]
+    inside = mask[vi[idx], ui[idx]]
+    idx = idx[inside]
+    surf = raster.depth[vi[idx], ui[idx]]
+    near = (surf > 0) & (z[idx] <= surf + slab_m)
+    return idx[near]
+
+
+def resegment(
+    frame: Frame,
+    mesh: TriMesh,
+    wfaces: np.ndarray,
+    proposal_faces: np.ndarray,
+    top_views: Sequence[TopView],
+    buffers: dict[str, np.ndarray],
+    point_segmenter: PointPromptSegmenter,
+    raster: RasterResult,
+    config: PipelineConfig,
+) -> tuple[np.ndarray, Mask2D]:
+    """Scan faces of the part segmented in ``frame`` (its best view, ``raster`` at full resolution),
+    and the mask used: visible faces under the mask, faces hidden right behind it (slab), and faces
+    the view cannot see under the other top-k masks; largest connected component."""
+    full = raster.face_ids
+    in_prop = np.zeros(mesh.n_faces + 1, bool)
+    in_prop[proposal_faces] = True
+    sil = in_prop[full]  # -1 -> last slot (False)
+    pts, lab = point_prompts(sil)
+    mask = point_segmenter.segment_points(frame, _image(frame), pts, lab) if len(pts) else None
+    if mask is None or mask.area == 0:
+        mask = top_views[0].mask
+    m = fill_holes(resize_mask(mask.mask, full.shape), config.perception.hole_close_px)
+    m = erode(m, max(1, scaled_px(config.fusion.erode_px, full.shape[1]) // 2))
+    vis = full[m]
+    faces = [np.unique(vis[vis >= 0])]
+    seen = np.zeros(mesh.n_faces + 1, bool)
+    seen[full] = True
+    seen[-1] = False
+    faces.append(hidden_behind(mesh, frame, raster, m, config.clip.keep_behind_m))
+    for tv in top_views:  # faces hidden from the segmenting view, seen under the part's other masks
+        if tv.frame_id == frame.frame_id or tv.mask is None or tv.frame_id not in buffers:
+            continue
+        ids = buffers[tv.frame_id]
+        mm = erode(fill_holes(resize_mask(tv.mask.mask, ids.shape), config.perception.hole_close_px),
+                   scaled_px(config.fusion.erode_px, ids.shape[1]))
+        f = ids[mm]
+        f = f[f >= 0]
+        faces.append(f[~seen[f]])
+    allf = np.unique(np.concatenate(faces)).astype(np.int64)
+    if not len(allf):
+        return allf, mask
+    return largest_component(mesh, wfaces, allf, config.fusion.attach_m), mask

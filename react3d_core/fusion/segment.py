@@ -1,0 +1,148 @@
+"""The whole segmentation stage: lift every frame's masks, fuse, pick top-k views, re-segment, clip."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from ..config import PipelineConfig
+from ..data.frames import Frame, SceneInput
+from ..data.masks import Mask2D
+from ..data.mesh import TriMesh
+from ..data.parts import PartCandidate
+from ..perception.interfaces import PointPromptSegmenter
+from ..raster import Rasterizer
+from ..raster.rasterizer import RasterResult
+from .clip import clip_part
+from .connectivity import largest_component
+from .lift import FrameLift, lift_masks
+from .proposals import FusionMesh, Proposal, fuse_proposals, prepare_fusion_mesh
+from .topk import select_top_views
+
+DUPLICATE_IOU = 0.5
+
+
+def render_work(rasterizer: Rasterizer, frame: Frame, config: PipelineConfig) -> RasterResult:
+    """Face-id buffer of ``frame`` at the fusion working width (config.fusion.work_width)."""
+    intr = frame.intrinsics
+    w = config.fusion.work_width
+    if w is not None and w < intr.width:
+        intr = intr.scaled(w, max(1, round(intr.height * w / intr.width)))
+    return rasterizer.render_frame(frame, intr)
+
+
+def lift_frames(
+    scene: SceneInput, masks: Mapping[str, Sequence[Mask2D]], rasterizer: Rasterizer, config: PipelineConfig
+) -> tuple[list[FrameLift], dict[str, np.ndarray]]:
+    """Render each frame with masks once (working width) and lift its masks; keeps the buffers for top-k."""
+    lifts, buffers = [], {}
+    for f in scene.frames:
+        ms = masks.get(f.frame_id)
+        if not ms:
+            continue
+        r = render_work(rasterizer, f, config)
+        buffers[f.frame_id] = r.face_ids
+        lifts.append(lift_masks(r, ms, config))
+    return lifts, buffers
+
+
+def _vertex_ids(mesh: TriMesh, faces: np.ndarray) -> np.ndarray:
+    return np.unique(mesh.faces[faces].ravel()).astype(np.int64)
+
+
+def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh) -> list[PartCandidate]:
+    """Proposals of several Louvain resolutions often re-segment to the same part: keep the best
+    scored of candidates whose vertex IoU > 0.5 (the cross-part dedup of issue 4 still runs later)."""
+    kept: list[PartCandidate] = []
+    for c in sorted(cands, key=lambda c: (-c.score, -len(c.face_ids))):
+        if all(len(np.intersect1d(c.vertex_ids, k.vertex_ids, assume_unique=True))
+               <= DUPLICATE_IOU * len(np.union1d(c.vertex_ids, k.vertex_ids)) for k in kept):
+            kept.append(c)
+    for i, c in enumerate(kept):
+        c.candidate_id = i
+    return kept
+
+
+def candidates_from_proposals(
+    scene: SceneInput,
+    mesh: TriMesh,
+    proposals: Sequence[Proposal],
+    buffers: dict[str, np.ndarray],
+    masks: Mapping[str, Sequence[Mask2D]],
+    point_segmenter: PointPromptSegmenter,
+    rasterizer: Rasterizer,
+    config: PipelineConfig,
+    wfaces: np.ndarray,
+) -> list[PartCandidate]:
+    """Top-k views, re-segmentation in the best view and clipping for each proposal."""
+    from .reseg import resegment
+
+    tops = select_top_views([p.face_ids for p in proposals], buffers, dict(masks), mesh.n_faces, config)
+    by_id = {f.frame_id: f for f in scene.frames}
+    out = []
+    renders: dict[str, RasterResult] = {}
+    for prop, tv in zip(proposals, tops):
+        if not tv:
+            continue
+        frame = by_id[tv[0].frame_id]
+        if frame.frame_id not in renders:
+            renders[frame.frame_id] = rasterizer.render_frame(frame)
+        faces, _mask = resegment(frame, mesh, wfaces, prop.face_ids, tv, buffers, point_segmenter, renders[frame.frame_id], config)
+        if not len(faces):
+            continue
+        kept, n, d = clip_part(mesh, faces, frame.c2w[:3, 3], config.clip)
+        if n is not None and len(kept):
+            kept = largest_component(mesh, wfaces, kept, config.fusion.attach_m)
+        if not len(kept):
+            continue
+        out.append(
+            PartCandidate(
+                candidate_id=len(out),
+                score=float(np.mean([t.iou for t in tv])),
+                face_ids=kept,
+                vertex_ids=_vertex_ids(mesh, kept),
+                top_views=list(tv),
+                seg_frame_id=frame.frame_id,
+                plane_normal=None if n is None else tuple(float(x) for x in n),
+                plane_offset=None if d is None else float(d),
+                proposal_face_ids=prop.face_ids,
+            )
+        )
+    return drop_duplicates(out, mesh)
+
+
+def segment_parts(
+    scene: SceneInput,
+    mesh: TriMesh,
+    masks: Mapping[str, Sequence[Mask2D]],
+    point_segmenter: PointPromptSegmenter,
+    config: PipelineConfig,
+    rasterizer: Rasterizer | None = None,
+    timings: dict[str, float] | None = None,
+    fusion_mesh: FusionMesh | None = None,
+) -> list[PartCandidate]:
+    """Masks per frame -> movable-part candidates on the full-resolution scan, with their top-k views.
+
+    ``timings`` (optional) receives seconds per sub-stage; ``fusion_mesh`` reuses a prepared
+    (decimated, welded) mesh across calls.
+    """
+    t = timings if timings is not None else {}
+    t0 = time.perf_counter()
+    rasterizer = rasterizer or Rasterizer(mesh)
+    fm = fusion_mesh or prepare_fusion_mesh(mesh, config)
+    t1 = time.perf_counter()
+    lifts, buffers = lift_frames(scene, masks, rasterizer, config)
+    t2 = time.perf_counter()
+    proposals = fuse_proposals(lifts, mesh, config, fm)
+    t3 = time.perf_counter()
+    from .connectivity import welded_faces
+
+    wfaces = fm.wfaces if fm.mesh is mesh else welded_faces(mesh, config.fusion.weld_m)
+    t4 = time.perf_counter()
+    cands = candidates_from_proposals(scene, mesh, proposals, buffers, masks, point_segmenter, rasterizer, config, wfaces)
+    t5 = time.perf_counter()
+    t.update(prepare=t1 - t0, weld_full=t4 - t3, lift=t2 - t1, fuse=t3 - t2, topk_reseg_clip=t5 - t4,
+             n_proposals=float(len(proposals)), n_candidates=float(len(cands)))
+    return cands
