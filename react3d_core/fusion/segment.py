@@ -22,6 +22,7 @@ from .proposals import FusionMesh, Proposal, fuse_proposals, prepare_fusion_mesh
 from .topk import select_top_views
 
 DUPLICATE_IOU = 0.5
+CONTAINED = 0.8
 
 
 def render_work(rasterizer: Rasterizer, frame: Frame, config: PipelineConfig) -> RasterResult:
@@ -52,13 +53,19 @@ def _vertex_ids(mesh: TriMesh, faces: np.ndarray) -> np.ndarray:
     return np.unique(mesh.faces[faces].ravel()).astype(np.int64)
 
 
+def _duplicate(c: PartCandidate, k: PartCandidate) -> bool:
+    inter = len(np.intersect1d(c.vertex_ids, k.vertex_ids, assume_unique=True))
+    union = len(c.vertex_ids) + len(k.vertex_ids) - inter
+    return inter > DUPLICATE_IOU * union or inter > CONTAINED * len(c.vertex_ids)
+
+
 def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh) -> list[PartCandidate]:
-    """Proposals of several Louvain resolutions often re-segment to the same part: keep the best
-    scored of candidates whose vertex IoU > 0.5 (the cross-part dedup of issue 4 still runs later)."""
+    """Proposals of several Louvain resolutions often re-segment to the same part, or to a piece of
+    it (seen cut off in their best view): keep the best-scored candidate, drop later ones with
+    vertex IoU > 0.5 or > 80 % of their vertices inside a kept one (issue 4's dedup still runs later)."""
     kept: list[PartCandidate] = []
     for c in sorted(cands, key=lambda c: (-c.score, -len(c.face_ids))):
-        if all(len(np.intersect1d(c.vertex_ids, k.vertex_ids, assume_unique=True))
-               <= DUPLICATE_IOU * len(np.union1d(c.vertex_ids, k.vertex_ids)) for k in kept):
+        if not any(_duplicate(c, k) for k in kept):
             kept.append(c)
     for i, c in enumerate(kept):
         c.candidate_id = i

@@ -18,15 +18,17 @@ from ..data.parts import TopView
 from .lift import REF_WIDTH, filled, scaled_px
 
 
-def usable(mask: Mask2D, config: PipelineConfig) -> bool:
-    """Masks touching the image border (within ``border_px``) or smaller than ``min_mask_px`` are skipped."""
+def big_enough(mask: Mask2D, config: PipelineConfig) -> bool:
+    """At least ``min_mask_px`` pixels (an area at 960 px width)."""
+    m = mask.mask
+    return bool(m.any()) and m.sum() >= config.topk.min_mask_px * (m.shape[1] / REF_WIDTH) ** 2
+
+
+def touches_border(mask: Mask2D, config: PipelineConfig) -> bool:
+    """Mask within ``border_px`` (at 960 px width) of the image border: the part is likely cut off."""
     m = mask.mask
     b = scaled_px(config.topk.border_px, m.shape[1])
-    if not m.any() or m.sum() < config.topk.min_mask_px * (m.shape[1] / REF_WIDTH) ** 2:  # area at 960 px width
-        return False
-    if b > 0 and (m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any()):
-        return False
-    return True
+    return b > 0 and bool(m[:b].any() or m[-b:].any() or m[:, :b].any() or m[:, -b:].any())
 
 
 def membership_matrix(proposal_faces: Sequence[np.ndarray], n_faces: int) -> sparse.csr_matrix:
@@ -60,17 +62,31 @@ def select_top_views(
     n_faces: int,
     config: PipelineConfig,
 ) -> list[list[TopView]]:
-    """For each proposal, its k best views (one mask per frame) with IoU > ``min_iou``, best first."""
+    """For each proposal, its k best views (one mask per frame) with IoU > ``min_iou``, best first.
+
+    Masks touching the border are skipped; only for a proposal no other mask matches (a part the
+    capture always cuts off, e.g. low cabinets) are they used, so such parts are not lost.
+    """
     P = membership_matrix(proposal_faces, n_faces)
-    best: list[list[TopView]] = [[] for _ in proposal_faces]
+    inner: list[list[TopView]] = [[] for _ in proposal_faces]
+    border: list[list[TopView]] = [[] for _ in proposal_faces]
     for fid, ids in buffers.items():
-        ms = [m for m in masks.get(fid, []) if usable(m, config)]
+        ms = [m for m in masks.get(fid, []) if big_enough(m, config)]
         if not ms or not len(proposal_faces):
             continue
         prepared = [filled(m.mask, ids.shape, config) for m in ms]
+        at_border = np.array([touches_border(m, config) for m in ms])
         iou = frame_ious(ids, prepared, P)
-        j = np.argmax(iou, 0)
-        top = iou[j, np.arange(iou.shape[1])]
-        for p in np.nonzero(top > config.topk.min_iou)[0]:
-            best[p].append(TopView(frame_id=fid, iou=float(top[p]), mask=ms[int(j[p])]))
-    return [sorted(b, key=lambda t: (-t.iou, t.frame_id))[: config.topk.k] for b in best]
+        for group, sel in ((inner, ~at_border), (border, at_border)):
+            if not sel.any():
+                continue
+            sub = np.where(sel[:, None], iou, -1.0)
+            j = np.argmax(sub, 0)
+            top = sub[j, np.arange(sub.shape[1])]
+            for p in np.nonzero(top > config.topk.min_iou)[0]:
+                group[p].append(TopView(frame_id=fid, iou=float(top[p]), mask=ms[int(j[p])]))
+    out = []
+    for a, b in zip(inner, border):
+        views = a if a else b
+        out.append(sorted(views, key=lambda t: (-t.iou, t.frame_id))[: config.topk.k])
+    return out
