@@ -66,6 +66,9 @@ def ransac_plane(points: np.ndarray, weights: np.ndarray, config: ClipConfig, vi
 def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, config: ClipConfig) -> tuple[np.ndarray, np.ndarray | None, float | None]:
     """Faces of the slab, and the plane (normal pointing away from the camera, offset) or None.
 
+    The plane is fitted to near-vertical faces facing the camera (all near-vertical faces when
+    fewer than 3 do, e.g. for unoriented meshes).
+
     Faces whose centroid lies more than ``keep_behind_m`` behind the plane are dropped; everything in
     front (handles) stays.
     """
@@ -74,6 +77,9 @@ def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, co
         return face_ids, None, None
     cen, nrm, area = face_geometry(mesh, face_ids)
     vert = np.abs(nrm[:, 2]) <= config.max_abs_nz
+    facing = vert & (((np.asarray(camera_center, float) - cen) * nrm).sum(1) > 0)
+    if facing.sum() >= 3:  # the front is what the camera sees: not the door's own back face
+        vert = facing
     if not vert.any():
         return face_ids, None, None
     foot = np.average(cen[vert], axis=0, weights=area[vert] + 1e-12)

@@ -63,6 +63,17 @@ def face_components(wfaces: np.ndarray, face_ids: np.ndarray) -> tuple[int, np.n
     return int(lab.max()) + 1, lab
 
 
+def surface_distance(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Exact distance from each point to the surface of ``triangles`` (T,3,3), Open3D/Embree."""
+    import open3d as o3d
+
+    scene = o3d.t.geometry.RaycastingScene()
+    v = np.ascontiguousarray(triangles.reshape(-1, 3), np.float32)
+    f = np.arange(len(v), dtype=np.uint32).reshape(-1, 3)
+    scene.add_triangles(o3d.core.Tensor(v), o3d.core.Tensor(f))
+    return scene.compute_distance(o3d.core.Tensor(np.ascontiguousarray(points, np.float32))).numpy()
+
+
 def largest_component(mesh: TriMesh, wfaces: np.ndarray, face_ids: np.ndarray, attach_m: float = 0.0) -> np.ndarray:
     """Faces of the largest (by area) component, plus components within ``attach_m`` of it.
 
@@ -78,8 +89,7 @@ def largest_component(mesh: TriMesh, wfaces: np.ndarray, face_ids: np.ndarray, a
     big = int(np.argmax(np.bincount(lab, weights=area, minlength=n)))
     keep = lab == big
     if attach_m > 0:
-        tree = cKDTree(tri[keep].reshape(-1, 3))
-        d, _ = tree.query(tri[~keep].reshape(-1, 3), distance_upper_bound=attach_m)
-        near_comp = np.unique(lab[~keep][np.isfinite(d.reshape(-1, 3)).any(1)])
+        d = surface_distance(tri[keep], tri[~keep].reshape(-1, 3)).reshape(-1, 3)
+        near_comp = np.unique(lab[~keep][(d <= attach_m).any(1)])
         keep |= np.isin(lab, near_comp)
     return face_ids[keep]

@@ -5,7 +5,8 @@ Two kinds of face pairs are counted, both linear in the lifted faces:
   sparse product — this is what separates two coplanar doors sharing an edge;
 * anchor pairs: every face of a mask is paired with the mask's ``a`` highest-priority faces
   (one global seeded priority, so the same pairs recur across masks and their counts add up),
-  ``a * |mask| <= max_pairs_per_mask``. They tie together faces that are not adjacent (a door split
+  ``a * |mask| <= max_pairs_per_mask`` (a mask larger than that pairs its first max_pairs faces in a
+  second global priority with one anchor). They tie together faces that are not adjacent (a door split
   by an occluder or a handle hole).
 Louvain runs on the graph contracted by mask signature (faces lying in exactly the same masks
 are indistinguishable to the graph; contracting them is Louvain's own first aggregation step).
@@ -35,20 +36,22 @@ def anchor_pairs(face_sets: Sequence[np.ndarray], n_nodes: int, max_pairs: int, 
     """(P,2) sampled pairs (i < j), at most ``max_pairs`` per mask; duplicates across masks kept."""
     rng = np.random.default_rng(seed)
     prio = rng.permutation(n_nodes)
+    prio2 = rng.permutation(n_nodes)  # picks the faces paired in masks larger than max_pairs
     out = []
     for s in face_sets:
         n = len(s)
         if n < 2:
             continue
         if n > max_pairs:
-            s = rng.choice(s, max_pairs, replace=False)
+            s = s[np.argpartition(prio2[s], max_pairs - 1)[:max_pairs]]
             n = max_pairs
         a = int(min(n - 1, max(1, max_pairs // n)))
         anchors = s[np.argpartition(prio[s], a - 1)[:a]] if a < n else s
         i = np.repeat(s, len(anchors))
         j = np.tile(anchors, n)
         keep = i != j
-        out.append(np.stack([np.minimum(i, j)[keep], np.maximum(i, j)[keep]], 1))
+        key = np.unique(np.minimum(i, j)[keep].astype(np.int64) * n_nodes + np.maximum(i, j)[keep])  # once per mask
+        out.append(np.stack([key // n_nodes, key % n_nodes], 1))
     return np.concatenate(out) if out else np.zeros((0, 2), np.int64)
 
 

@@ -84,7 +84,11 @@ def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineCo
     graph = face_graph(counts, fc.min_cooccurrence)
     M = membership(sets, n)
     support = np.asarray(M.sum(0)).ravel()
-    nodes = np.nonzero(support > 0)[0]
+    # a face in fewer masks than min_cooccurrence can have no edge; faces with equal mask sets
+    # co-occur in all of them (a clique of the exact co-occurrence graph) and are contracted
+    nodes = np.nonzero(support >= max(1, fc.min_cooccurrence))[0]
+    if not len(nodes):
+        return []
     rng = np.random.default_rng(fc.seed)
     sig = (M[:, nodes].T @ rng.random(M.shape[0])).astype(np.float64)
     sig = np.round(sig * 1e9).astype(np.int64)  # equal mask sets -> equal signature

@@ -1,0 +1,237 @@
+"""Fusion sub-steps on hand-made geometry with hand-computed answers."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+from geometry import frames, grid, merge, two_doors  # noqa: E402
+
+from react3d_core.config import ClipConfig, PipelineConfig
+from react3d_core.data.masks import Mask2D
+from react3d_core.data.mesh import TriMesh
+from react3d_core.fusion import (
+    clip_part,
+    fill_holes,
+    fuse_proposals,
+    largest_component,
+    lift_masks,
+    point_prompts,
+    ransac_plane,
+    select_top_views,
+    weld_labels,
+)
+from react3d_core.fusion.connectivity import edge_adjacency, face_components
+from react3d_core.fusion.graph import anchor_pairs, cooccurrence, face_graph
+from react3d_core.fusion.topk import frame_ious, membership_matrix
+from react3d_core.raster import Rasterizer
+from react3d_core.raster.rasterizer import RasterResult
+
+
+def cfg(**fusion) -> PipelineConfig:
+    return PipelineConfig().with_overrides({"fusion": {"decimate_faces": None, "work_width": None, **fusion}})
+
+
+# -- masks -----------------------------------------------------------------------------------
+def test_fill_holes_fills_enclosed_hole_and_closes_notch():
+    m = np.zeros((40, 96), bool)
+    m[5:35, 10:50] = True
+    m[15:20, 20:25] = False  # enclosed hole (a missed handle)
+    m[0:10, 60:80] = True
+    m[3:10, 69:71] = False  # 2 px notch open at the bottom
+    out = fill_holes(m, close_px=0)
+    assert out[15:20, 20:25].all()  # hole filled without closing
+    assert not out[3:10, 69:71].any()  # notch is not a hole
+    out = fill_holes(m, close_px=40)  # 4 px kernel at 96 px width
+    assert out[3:9, 69:71].all()  # closed up to the mask outline
+    assert not out[20:40, 0:10].any()  # nothing grows outside
+
+
+def test_lift_masks_collects_visible_faces_under_eroded_mask():
+    ids = np.full((10, 20), -1, np.int32)
+    ids[:, :10] = 3
+    ids[:, 10:] = 7
+    ids[4:6, 4:6] = 9  # a 2x2 face inside the left half
+    r = RasterResult("f", ids, np.ones_like(ids, np.float32))
+    left = np.zeros((10, 20), bool)
+    left[:, :11] = True  # bleeds one column into face 7
+    c = cfg(erode_px=0)
+    c = c.with_overrides({"perception": {"hole_close_px": 0}})
+    lf = lift_masks(r, [Mask2D(frame_id="f", mask=left)], c)
+    assert [s.tolist() for s in lf.face_sets] == [[3, 7, 9]]
+    c = c.with_overrides({"fusion": {"erode_px": 96}})  # 2 px at 20 px width: the bleed column 10 goes
+    lf = lift_masks(r, [Mask2D(frame_id="f", mask=left)], c)
+    assert [s.tolist() for s in lf.face_sets] == [[3, 9]]
+    big = np.zeros((20, 40), bool)  # a mask at twice the raster's size is resized (nearest)
+    big[:, 22:] = True
+    lf = lift_masks(r, [Mask2D(frame_id="f", mask=big)], cfg(erode_px=0))
+    assert [s.tolist() for s in lf.face_sets] == [[7]]
+
+
+# -- graph -----------------------------------------------------------------------------------
+def test_cooccurrence_counts_by_hand():
+    # masks {0,1,2}, {1,2}, {2,3}; adjacency (0,1), (1,2), (2,3), (0,3)
+    sets = [np.array([0, 1, 2]), np.array([1, 2]), np.array([2, 3])]
+    adj = np.array([[0, 1], [1, 2], [2, 3], [0, 3]])
+    c = cooccurrence(sets, 4, adj, max_pairs=1, seed=0).tocsr()
+    assert c[0, 1] == 1 and c[1, 2] == 2 and c[2, 3] == 1 and c[0, 3] == 0
+    g = face_graph(c.tocoo(), 2)
+    assert list(zip(g.row.tolist(), g.col.tolist())) == [(1, 2)]
+    # without adjacency, anchors: all pairs of a 3-face mask fit in max_pairs = 6
+    c = cooccurrence(sets, 4, np.zeros((0, 2), int), max_pairs=6, seed=0).tocsr()
+    assert c[1, 2] == 2 and c[0, 1] == 1 and c[0, 2] == 1 and c[2, 3] == 1
+
+
+def test_anchor_pairs_respect_the_cap_and_recur_across_masks():
+    rng = np.random.default_rng(0)
+    s = np.unique(rng.integers(0, 5000, 3000))
+    pairs = anchor_pairs([s, s], 5000, max_pairs=1000, seed=1)
+    assert len(pairs) <= 2 * 1000
+    u, cnt = np.unique(pairs, axis=0, return_counts=True)
+    assert (cnt == 2).all()  # same global anchors: each pair counted by both masks
+    assert (pairs[:, 0] < pairs[:, 1]).all()
+
+
+def test_edge_adjacency_and_weld():
+    f = np.array([[0, 1, 2], [1, 3, 2], [4, 5, 6]])
+    assert edge_adjacency(f).tolist() == [[0, 1]]
+    v = np.array([[0, 0, 0], [0.001, 0, 0], [1, 0, 0]])
+    lab = weld_labels(v, 0.005)
+    assert lab[0] == lab[1] != lab[2]
+
+
+def test_components_weld_and_attach():
+    a = grid(0, 1, 0, 1, 0.0, 4, 4)
+    b = grid(0, 1, 0, 1, 0.0, 4, 4)  # unwelded duplicate on top of a: welded, one component
+    far = grid(5, 5.2, 0, 0.2, 0.0, 1, 1)
+    handle = grid(0.4, 0.6, 0.4, 0.6, -0.01, 1, 1)  # 1 cm in front of a, no shared vertex
+    m, (ia, ib, ifar, ih) = merge(a, b, far, handle)
+    wf = weld_labels(m.vertices, 0.005)[m.faces]
+    n, _ = face_components(wf, np.concatenate([ia, ib, ifar, ih]))
+    assert n == 3
+    keep = largest_component(m, wf, np.arange(m.n_faces))
+    assert set(keep.tolist()) == set(np.concatenate([ia, ib]).tolist())
+    keep = largest_component(m, wf, np.arange(m.n_faces), attach_m=0.02)
+    assert set(keep.tolist()) == set(np.concatenate([ia, ib, ih]).tolist())
+
+
+# -- fusion on rendered hand-made scenes ------------------------------------------------------
+def _lifts(mesh: TriMesh, parts: list[np.ndarray], frs, config):
+    R = Rasterizer(mesh)
+    lifts, buffers, masks = [], {}, {}
+    for f in frs:
+        r = R.render_frame(f)
+        ms = [Mask2D(frame_id=f.frame_id, mask=np.isin(r.face_ids, p)) for p in parts]
+        ms = [m for m in ms if m.area]
+        buffers[f.frame_id], masks[f.frame_id] = r.face_ids, ms
+        lifts.append(lift_masks(r, ms, config))
+    return lifts, buffers, masks
+
+
+def _face_iou(a: np.ndarray, b: np.ndarray) -> float:
+    return len(np.intersect1d(a, b)) / len(np.union1d(a, b))
+
+
+def test_two_coplanar_doors_sharing_an_edge_are_two_parts():
+    mesh, a, b = two_doors()
+    c = cfg()
+    lifts, _, _ = _lifts(mesh, [a, b], frames(4), c)
+    props = fuse_proposals(lifts, mesh, c)
+    best_a = max(_face_iou(p.face_ids, a) for p in props)
+    best_b = max(_face_iou(p.face_ids, b) for p in props)
+    assert best_a > 0.8 and best_b > 0.8
+    assert all(_face_iou(p.face_ids, np.concatenate([a, b])) < 0.7 for p in props)  # never merged
+
+
+def test_a_mask_seen_in_one_frame_yields_a_proposal_with_min_cooccurrence_1():
+    mesh, a, _b = two_doors()
+    c = cfg(min_cooccurrence=1)
+    lifts, _, _ = _lifts(mesh, [a], frames(1), c)
+    props = fuse_proposals(lifts, mesh, c)
+    assert props and max(_face_iou(p.face_ids, a) for p in props) > 0.8
+    c3 = cfg(min_cooccurrence=3)  # a single mask never reaches 3 co-occurrences: no graph edges
+    assert fuse_proposals(lifts, mesh, c3) == []
+
+
+def test_decimated_fusion_maps_back_to_scan_faces():
+    mesh, a, b = two_doors()
+    c = cfg().with_overrides({"fusion": {"decimate_faces": 1500}})
+    lifts, _, _ = _lifts(mesh, [a, b], frames(4), c)
+    props = fuse_proposals(lifts, mesh, c)
+    assert max(_face_iou(p.face_ids, a) for p in props) > 0.6
+    assert max(_face_iou(p.face_ids, b) for p in props) > 0.6
+    assert all(p.face_ids.max() < mesh.n_faces for p in props)
+
+
+# -- top-k --------------------------------------------------------------------------------------
+def test_frame_iou_by_hand_is_occlusion_aware():
+    ids = np.array([[0, 0, 1, 1], [0, 0, 2, -1]])  # face 1 hidden where face 2 is in front
+    P = membership_matrix([np.array([0]), np.array([1, 2])], 3)
+    mask = np.array([[1, 1, 1, 0], [0, 0, 0, 0]], bool)
+    iou = frame_ious(ids, [mask], P)
+    # proposal 0: silhouette 4 px, mask 3 px, intersection 2 -> 2 / 5; proposal 1: sil 3, inter 1 -> 1 / 5
+    assert iou[0, 0] == pytest.approx(2 / 5) and iou[0, 1] == pytest.approx(1 / 5)
+
+
+def test_top_views_rank_and_skip_border_masks():
+    mesh, a, b = two_doors()
+    c = cfg().with_overrides({"topk": {"k": 2, "border_px": 20, "min_mask_px": 100}})
+    frs = frames(4, 320, 240)
+    _, buffers, masks = _lifts(mesh, [a], frs, c)
+    # spoil one view's mask: half of it -> lower IoU, still > 0.5 is not guaranteed: drop it entirely
+    fid = frs[1].frame_id
+    m = masks[fid][0].mask.copy()
+    m[:, : m.shape[1] // 2] = False
+    masks[fid] = [Mask2D(frame_id=fid, mask=m)]
+    tv = select_top_views([a], buffers, masks, mesh.n_faces, c)[0]
+    assert len(tv) == 2 and tv[0].iou >= tv[1].iou > 0.9
+    assert fid not in [t.frame_id for t in tv]
+    edge = np.zeros((240, 320), bool)
+    edge[100:200, 0:150] = True  # touches the left border: used only when nothing else matches
+    only = {fid: [Mask2D(frame_id=fid, mask=edge)]}
+    assert select_top_views([a], buffers, only, mesh.n_faces, c.with_overrides({"topk": {"min_iou": 0.0}}))[0][0].frame_id == fid
+
+
+# -- re-segmentation prompts -------------------------------------------------------------------
+def test_point_prompts_inside_and_outside():
+    sil = np.zeros((60, 80), bool)
+    sil[10:40, 20:60] = True
+    pts, lab = point_prompts(sil, n_pos=3, n_neg=4)
+    pos, neg = pts[lab == 1].astype(int), pts[lab == 0].astype(int)
+    assert len(pos) == 3 and sil[pos[:, 1], pos[:, 0]].all()
+    assert len(neg) == 4 and not sil[neg[:, 1], neg[:, 0]].any()
+    # deepest points of a 40 x 30 box: 15 px from the border, on the mid-height ridge x in [34, 45]
+    assert pos[0, 1] in (24, 25) and 34 <= pos[0, 0] <= 45
+
+
+# -- clipping ---------------------------------------------------------------------------------
+def test_ransac_plane_by_hand():
+    rng = np.random.default_rng(0)
+    p = np.c_[np.full(200, 0.3), rng.uniform(0, 1, 200), rng.uniform(0, 1, 200)]  # plane x = 0.3
+    n, d = ransac_plane(p, np.ones(200), ClipConfig())
+    assert abs(abs(n[0]) - 1) < 1e-6 and abs(d / n[0] + 0.3) < 1e-6
+
+
+def test_clip_keeps_front_slab_and_handle_drops_carcass():
+    front = grid(0, 0.5, 0, 0.8, -0.02, 10, 16)  # door front at y = -0.02, camera at y = -2
+    back = grid(0, 0.5, 0, 0.8, 0.0, 10, 16)  # door back 2 cm behind: kept (keep_behind 3 cm)
+    back.faces = back.faces[:, ::-1].copy()  # facing +y, away from the camera
+    handle = grid(0.4, 0.45, 0.3, 0.5, -0.05, 1, 2)  # 3 cm in front
+    side = grid(0, 0.5, 0, 0.8, 0.0, 10, 16)
+    side.vertices = side.vertices[:, [1, 0, 2]]  # carcass side: plane x = 0, y in [0, 0.5]
+    top = grid(0, 0.5, 0.1, 0.5, 0.8, 5, 5)
+    top.vertices = top.vertices[:, [0, 2, 1]]  # horizontal, y in [0.1, 0.5] behind the door
+    mesh, (f, b, h, s, t) = merge(front, back, handle, side, top)
+    keep, n, d = clip_part(mesh, np.arange(mesh.n_faces), np.array([0.25, -2.0, 0.4]), ClipConfig())
+    assert np.allclose(n, [0, 1, 0], atol=1e-6) and d == pytest.approx(0.02, abs=1e-6)  # y + 0.02 = 0
+    kept = set(keep.tolist())
+    assert set(f.tolist()) <= kept and set(b.tolist()) <= kept and set(h.tolist()) <= kept
+    cen = mesh.vertices[mesh.faces].mean(1)
+    deep = np.concatenate([s, t])[cen[np.concatenate([s, t]), 1] > 0.05]
+    assert len(deep) and not (set(deep.tolist()) & kept)
+    off, n0, _ = clip_part(mesh, np.arange(mesh.n_faces), np.zeros(3), ClipConfig(enabled=False))
+    assert n0 is None and len(off) == mesh.n_faces
