@@ -5,7 +5,7 @@ Two kinds of face pairs are counted, both linear in the lifted faces:
   sparse product — this is what separates two coplanar doors sharing an edge;
 * anchor pairs: every face of a mask is paired with the mask's ``a`` highest-priority faces
   (one global seeded priority, so the same pairs recur across masks and their counts add up),
-  ``a * |mask| <= max_pairs_per_mask`` (a mask larger than that pairs its first max_pairs faces in a
+  ``a <= 8``, ``a * |mask| <= max_pairs_per_mask`` (a mask larger than that pairs its first max_pairs faces in a
   second global priority with one anchor). They tie together faces that are not adjacent (a door split
   by an occluder or a handle hole).
 Louvain runs on the graph contracted by mask signature (faces lying in exactly the same masks
@@ -19,6 +19,8 @@ from collections.abc import Sequence
 import networkx as nx
 import numpy as np
 from scipy import sparse
+
+MAX_ANCHORS = 8  # anchors per mask: enough to bridge gaps, keeps pairs ~8 per lifted face
 
 
 def membership(face_sets: Sequence[np.ndarray], n_nodes: int) -> sparse.csr_matrix:
@@ -45,7 +47,7 @@ def anchor_pairs(face_sets: Sequence[np.ndarray], n_nodes: int, max_pairs: int, 
         if n > max_pairs:
             s = s[np.argpartition(prio2[s], max_pairs - 1)[:max_pairs]]
             n = max_pairs
-        a = int(min(n - 1, max(1, max_pairs // n)))
+        a = int(min(n - 1, MAX_ANCHORS, max(1, max_pairs // n)))
         anchors = s[np.argpartition(prio[s], a - 1)[:a]] if a < n else s
         i = np.repeat(s, len(anchors))
         j = np.tile(anchors, n)

@@ -67,6 +67,19 @@ def prepare_fusion_mesh(mesh: TriMesh, config: PipelineConfig) -> FusionMesh:
     return FusionMesh(small, fmap, wf, edge_adjacency(wf))
 
 
+def _distinct(comms: Sequence[np.ndarray], n: int, same: float = 0.95) -> list[int]:
+    """Indices of communities to keep: a community found again (Jaccard > ``same``) is dropped."""
+    if not comms:
+        return []
+    C = membership(list(comms), n)
+    inter = (C @ C.T).tocoo()
+    size = np.array([len(c) for c in comms], float)
+    jac = inter.data / (size[inter.row] + size[inter.col] - inter.data)
+    dup = (inter.row > inter.col) & (jac > same)  # later one duplicates an earlier one
+    drop = set(inter.row[dup].tolist())
+    return [i for i in range(len(comms)) if i not in drop]
+
+
 def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineConfig, fusion_mesh: FusionMesh | None = None) -> list[Proposal]:
     """Co-occurrence graph of the lifted faces -> Louvain communities at each resolution -> proposals.
 
@@ -93,20 +106,18 @@ def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineCo
     sig = (M[:, nodes].T @ rng.random(M.shape[0])).astype(np.float64)
     sig = np.round(sig * 1e9).astype(np.int64)  # equal mask sets -> equal signature
     comms = louvain(graph, nodes, sig, fc.resolutions, fc.seed)
-    seen: list[np.ndarray] = []
-    out: list[Proposal] = []
+    kept: list[tuple[float, np.ndarray]] = []
     for res, com in comms:
         if len(com) <= fc.min_community_faces:
             continue
         com = largest_component(fm.mesh, fm.wfaces, com)
-        if len(com) <= fc.min_community_faces:
-            continue
-        if any(len(np.intersect1d(com, s, assume_unique=True)) / len(np.union1d(com, s)) > 0.95 for s in seen):
-            continue
-        seen.append(com)
+        if len(com) > fc.min_community_faces:
+            kept.append((res, com))
+    out: list[Proposal] = []
+    for i in _distinct([c for _, c in kept], n):
+        res, com = kept[i]
         in_com = np.zeros(n, bool)
         in_com[com] = True
         faces = np.nonzero(in_com[fm.face_map])[0]
-        sup = int(np.median(support[com]))
-        out.append(Proposal(len(out), faces, res, sup))
+        out.append(Proposal(len(out), faces, res, int(np.median(support[com]))))
     return out

@@ -20,6 +20,7 @@ from ..data.parts import TopView
 from ..errors import InputError
 from ..perception.interfaces import PointPromptSegmenter
 from ..camera import project
+from ..raster import Rasterizer
 from ..raster.rasterizer import RasterResult
 from .connectivity import largest_component
 from .lift import erode, fill_holes, resize_mask, scaled_px
@@ -65,56 +66,85 @@ def _image(frame: Frame) -> np.ndarray:
         return np.zeros((frame.intrinsics.height, frame.intrinsics.width, 3), np.uint8)
 
 
-def hidden_behind(mesh: TriMesh, frame: Frame, raster: RasterResult, mask: np.ndarray, slab_m: float) -> np.ndarray:
-    """Faces hidden from the view whose centroid projects inside ``mask`` and lies at most ``slab_m``
-    behind the visible surface there (the back and edges of a door or drawer front)."""
+def hidden_behind(mesh: TriMesh, centroids: np.ndarray, K: np.ndarray, w2c: np.ndarray, raster: RasterResult,
+                  mask: np.ndarray, slab_m: float) -> np.ndarray:
+    """Faces whose centroid projects inside ``mask`` (``K`` for the buffer's pixels) and lies at most
+    ``slab_m`` behind the visible surface there (the back and edges of a door or drawer front).
+    Only faces within the 3D box of the visible masked surface (+ slab) are projected."""
     h, w = mask.shape
-    intr = frame.intrinsics if frame.intrinsics.width == w else frame.intrinsics.scaled(w, h)
-    cen = mesh.vertices[mesh.faces].mean(1)
-    uv, z = project(cen, intr.K, frame.w2c)
+    f = raster.face_ids[mask]
+    f = f[f >= 0]
+    if not len(f):
+        return np.zeros(0, np.int64)
+    vis = centroids[np.unique(f)]
+    lo, hi = vis.min(0) - slab_m - 0.01, vis.max(0) + slab_m + 0.01
+    idx = np.nonzero(np.all((centroids >= lo) & (centroids <= hi), 1))[0]
+    uv, z = project(centroids[idx], K, w2c)
     ok = (z > 0) & np.all(np.isfinite(uv), 1)
-    ui = np.full(len(z), -1)
-    vi = np.full(len(z), -1)
-    ui[ok], vi[ok] = np.round(uv[ok, 0]).astype(int), np.round(uv[ok, 1]).astype(int)
-    ok &= (ui >= 0) & (ui < w) & (vi >= 0) & (vi < h)
-    idx = np.nonzero(ok)[0]
-    inside = mask[vi[idx], ui[idx]]
-    idx = idx[inside]
-    surf = raster.depth[vi[idx], ui[idx]]
-    near = (surf > 0) & (z[idx] <= surf + slab_m)
-    return idx[near]
+    idx, uv, z = idx[ok], uv[ok], z[ok]
+    ui, vi = np.round(uv[:, 0]).astype(np.int64), np.round(uv[:, 1]).astype(np.int64)
+    ok = (ui >= 0) & (ui < w) & (vi >= 0) & (vi < h)
+    idx, ui, vi, z = idx[ok], ui[ok], vi[ok], z[ok]
+    inside = mask[vi, ui]
+    idx, ui, vi, z = idx[inside], ui[inside], vi[inside], z[inside]
+    surf = raster.depth[vi, ui]
+    return idx[(surf > 0) & (z <= surf + slab_m)]
+
+
+def render_crop(rasterizer: Rasterizer, frame: Frame, box: tuple[int, int, int, int]) -> tuple[RasterResult, np.ndarray]:
+    """Full-resolution buffers of the pixel box (x0, y0, x1, y1) only, and the crop's K."""
+    x0, y0, x1, y1 = box
+    K = frame.intrinsics.K.copy()
+    K[0, 2] -= x0
+    K[1, 2] -= y0
+    return rasterizer.render(K, frame.c2w, x1 - x0, y1 - y0, frame.frame_id), K
 
 
 def resegment(
     frame: Frame,
     mesh: TriMesh,
     wfaces: np.ndarray,
+    centroids: np.ndarray,
     proposal_faces: np.ndarray,
     top_views: Sequence[TopView],
     buffers: dict[str, np.ndarray],
     point_segmenter: PointPromptSegmenter,
-    raster: RasterResult,
+    rasterizer: Rasterizer,
     config: PipelineConfig,
 ) -> tuple[np.ndarray, Mask2D]:
-    """Scan faces of the part segmented in ``frame`` (its best view, ``raster`` at full resolution),
-    and the mask used: visible faces under the mask, faces hidden right behind it (slab), and faces
-    the view cannot see under the other top-k masks; largest connected component."""
-    full = raster.face_ids
+    """Scan faces of the part segmented in ``frame`` (its best view), and the mask used.
+
+    Prompts come from the proposal's silhouette in the working-resolution buffer; the mask is
+    back-projected at full resolution (only its bounding box is rendered): visible faces under it,
+    faces hidden right behind it (slab), and faces this view cannot see under the other top-k
+    masks; then the largest connected component (+ attached handles).
+    """
+    W, H = frame.intrinsics.width, frame.intrinsics.height
+    ids_w = buffers[frame.frame_id]
     in_prop = np.zeros(mesh.n_faces + 1, bool)
     in_prop[proposal_faces] = True
-    sil = in_prop[full]  # -1 -> last slot (False)
+    sil = in_prop[ids_w]  # -1 -> last slot (False)
     pts, lab = point_prompts(sil)
+    sx, sy = W / ids_w.shape[1], H / ids_w.shape[0]
+    pts = np.clip((pts + 0.5) * [sx, sy] - 0.5, 0, [W - 1, H - 1])
     mask = point_segmenter.segment_points(frame, _image(frame), pts, lab) if len(pts) else None
     if mask is None or mask.area == 0:
         mask = top_views[0].mask
-    m = fill_holes(resize_mask(mask.mask, full.shape), config.perception.hole_close_px)
-    m = erode(m, max(1, scaled_px(config.fusion.erode_px, full.shape[1]) // 2))
-    vis = full[m]
+    m = fill_holes(resize_mask(mask.mask, (H, W)), config.perception.hole_close_px)
+    m = erode(m, max(1, scaled_px(config.fusion.erode_px, W) // 2))
+    ys, xs = np.nonzero(m.any(1))[0], np.nonzero(m.any(0))[0]
+    if not len(ys):
+        return np.zeros(0, np.int64), mask
+    box = (int(xs[0]), int(ys[0]), int(xs[-1]) + 1, int(ys[-1]) + 1)
+    crop, Kc = render_crop(rasterizer, frame, box)
+    mc = m[box[1] : box[3], box[0] : box[2]]
+    vis = crop.face_ids[mc]
     faces = [np.unique(vis[vis >= 0])]
+    faces.append(hidden_behind(mesh, centroids, Kc, frame.w2c, crop, mc, config.clip.keep_behind_m))
     seen = np.zeros(mesh.n_faces + 1, bool)
-    seen[full] = True
+    seen[ids_w] = True
+    seen[crop.face_ids] = True
     seen[-1] = False
-    faces.append(hidden_behind(mesh, frame, raster, m, config.clip.keep_behind_m))
     for tv in top_views:  # faces hidden from the segmenting view, seen under the part's other masks
         if tv.frame_id == frame.frame_id or tv.mask is None or tv.frame_id not in buffers:
             continue

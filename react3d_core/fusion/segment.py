@@ -89,14 +89,12 @@ def candidates_from_proposals(
     tops = select_top_views([p.face_ids for p in proposals], buffers, dict(masks), mesh.n_faces, config)
     by_id = {f.frame_id: f for f in scene.frames}
     out = []
-    renders: dict[str, RasterResult] = {}
+    centroids = mesh.vertices[mesh.faces].mean(1)
     for prop, tv in zip(proposals, tops):
         if not tv:
             continue
         frame = by_id[tv[0].frame_id]
-        if frame.frame_id not in renders:
-            renders[frame.frame_id] = rasterizer.render_frame(frame)
-        faces, _mask = resegment(frame, mesh, wfaces, prop.face_ids, tv, buffers, point_segmenter, renders[frame.frame_id], config)
+        faces, _mask = resegment(frame, mesh, wfaces, centroids, prop.face_ids, tv, buffers, point_segmenter, rasterizer, config)
         if not len(faces):
             continue
         kept, n, d = clip_part(mesh, faces, frame.c2w[:3, 3], config.clip)
