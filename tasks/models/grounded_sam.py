@@ -1,0 +1,191 @@
+"""Grounded-SAM through ``transformers``: Grounding DINO boxes for text phrases, SAM masks for the boxes.
+
+Batched: one detector forward and one SAM image-encoder forward per batch of frames (the expensive
+parts); the SAM mask decoder then runs per frame with all of that frame's boxes at once. Masks come
+back at each frame's RGB resolution (hole filling is the fusion stage's job). SAM 2 checkpoints
+(``facebook/sam2*``) are supported through Sam2Model/Sam2Processor, run per frame (simplified path).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import torch
+
+from react3d_core.data.frames import Frame
+from react3d_core.data.masks import Mask2D
+
+from .runtime import Loaded
+
+
+def detector_prompt(phrases: Sequence[str]) -> str:
+    """Grounding DINO's text format: lower-case phrases, each ended by ' .' (as in its model card)."""
+    return " ".join(p.strip().lower().rstrip(".") + "." for p in phrases if p.strip())
+
+
+def match_phrase(label: str, phrases: Sequence[str]) -> str:
+    """Map a decoded Grounding DINO label (sub-phrase tokens) to the prompt phrase sharing most words."""
+    words = set(label.lower().replace(".", " ").split())
+    best, best_n = label.strip() or (phrases[0] if phrases else "openable"), 0
+    for p in phrases:
+        n = len(words & set(p.lower().split()))
+        if n > best_n:
+            best, best_n = p, n
+    return best
+
+
+def is_sam2(loaded: Loaded) -> bool:
+    return type(loaded.model).__name__.startswith("Sam2")
+
+
+@dataclass
+class Detection:
+    """Boxes (N,4 x0y0x1y1 px of the original image), scores (N,), labels (N phrases)."""
+
+    boxes: np.ndarray
+    scores: np.ndarray
+    labels: list[str]
+
+
+def detect(det: Loaded, images: Sequence[np.ndarray], phrases: Sequence[str],
+           box_threshold: float, text_threshold: float) -> list[Detection]:
+    """One batched Grounding DINO forward; boxes mapped back to each image's own pixel size."""
+    prompt = detector_prompt(phrases)
+    inputs = det.processor(images=list(images), text=[prompt] * len(images), return_tensors="pt", padding=True)
+    inputs = {k: (v.to(det.device, det.dtype) if v.is_floating_point() else v.to(det.device)) for k, v in inputs.items()}
+    with torch.inference_mode():
+        out = det.model(**inputs)
+    out.logits, out.pred_boxes = out.logits.float(), out.pred_boxes.float()
+    sizes = [im.shape[:2] for im in images]
+    res = det.processor.post_process_grounded_object_detection(
+        out, inputs["input_ids"], threshold=box_threshold, text_threshold=text_threshold, target_sizes=sizes
+    )
+    dets = []
+    for r, (h, w) in zip(res, sizes):
+        boxes = r["boxes"].detach().cpu().numpy().reshape(-1, 4).astype(float)
+        boxes[:, [0, 2]] = boxes[:, [0, 2]].clip(0, w)
+        boxes[:, [1, 3]] = boxes[:, [1, 3]].clip(0, h)
+        keep = (boxes[:, 2] - boxes[:, 0] >= 1) & (boxes[:, 3] - boxes[:, 1] >= 1)
+        labels = r.get("text_labels", r.get("labels", []))
+        dets.append(Detection(boxes[keep], r["scores"].detach().cpu().numpy()[keep].astype(float),
+                              [match_phrase(str(l), phrases) for l, k in zip(labels, keep) if k]))
+    return dets
+
+
+def sam_image_embeddings(sam: Loaded, images: Sequence[np.ndarray]) -> tuple[torch.Tensor, dict]:
+    """One batched SAM image-encoder forward (the 600M-parameter part for ViT-H)."""
+    inputs = sam.processor(images=list(images), return_tensors="pt")
+    with torch.inference_mode():
+        emb = sam.model.get_image_embeddings(inputs["pixel_values"].to(sam.device, sam.dtype))
+    return emb, inputs
+
+
+def masks_to_original(sam: Loaded, low_res: torch.Tensor, original_size: Sequence[int],
+                      reshaped_size: Sequence[int]) -> np.ndarray:
+    """SAM low-res logits (1,N,1,h,w) -> bool (N,H,W) at the original image size (unpad, resize, >0)."""
+    m = sam.processor.image_processor.post_process_masks(
+        low_res.float().cpu(), torch.tensor([list(original_size)]), torch.tensor([list(reshaped_size)])
+    )[0]
+    return m[:, 0].numpy().astype(bool)
+
+
+def sam_box_masks(sam: Loaded, emb: torch.Tensor, inputs: dict, i: int, image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """Masks (N,H,W) of frame ``i`` of an embedded batch for its N boxes (original pixel coordinates)."""
+    prompt = sam.processor(images=[image], input_boxes=[boxes.tolist()], return_tensors="pt")
+    with torch.inference_mode():
+        out = sam.model(image_embeddings=emb[i : i + 1], input_boxes=prompt["input_boxes"].to(sam.device, sam.dtype),
+                        multimask_output=False)
+    return masks_to_original(sam, out.pred_masks, inputs["original_sizes"][i].tolist(), inputs["reshaped_input_sizes"][i].tolist())
+
+
+def sam2_box_masks(sam: Loaded, image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+    """SAM 2 box prompts on one image (simplified per-frame path: encoder and decoder together)."""
+    prompt = sam.processor(images=[image], input_boxes=[boxes.tolist()], return_tensors="pt")
+    feed = {k: (v.to(sam.device, sam.dtype) if v.is_floating_point() else v.to(sam.device))
+            for k, v in prompt.items() if k in ("pixel_values", "input_boxes")}
+    with torch.inference_mode():
+        out = sam.model(**feed, multimask_output=False)
+    m = sam.processor.post_process_masks(out.pred_masks.float().cpu(), prompt["original_sizes"])[0]
+    return m[:, 0].numpy().astype(bool)
+
+
+class GroundedSamSegmenter:
+    """TextPromptSegmenter: Grounding DINO (box/text thresholds 0.3/0.25 in the paper) + SAM box prompts."""
+
+    def __init__(self, detector: Loaded, sam: Loaded, box_threshold: float, text_threshold: float, batch_size: int) -> None:
+        self.detector, self.sam = detector, sam
+        self.box_threshold, self.text_threshold, self.batch_size = box_threshold, text_threshold, batch_size
+
+    def segment(self, frames: Sequence[Frame], images: Sequence[np.ndarray], phrases: Sequence[str]) -> list[list[Mask2D]]:
+        if len(frames) != len(images):
+            raise ValueError(f"{len(frames)} frames but {len(images)} images")
+        phrases = [p for p in phrases if p.strip()]
+        if not phrases:
+            return [[] for _ in frames]
+        out: list[list[Mask2D]] = []
+        for s in range(0, len(frames), self.batch_size):
+            fr, im = list(frames[s : s + self.batch_size]), list(images[s : s + self.batch_size])
+            dets = detect(self.detector, im, phrases, self.box_threshold, self.text_threshold)
+            want = [i for i, d in enumerate(dets) if len(d.boxes)]
+            emb = inputs = None
+            if want and not is_sam2(self.sam):
+                emb, inputs = sam_image_embeddings(self.sam, [im[i] for i in want])
+            for i, (f, image, d) in enumerate(zip(fr, im, dets)):
+                if not len(d.boxes):
+                    out.append([])
+                    continue
+                if is_sam2(self.sam):
+                    masks = sam2_box_masks(self.sam, image, d.boxes)
+                else:
+                    masks = sam_box_masks(self.sam, emb, inputs, want.index(i), image, d.boxes)
+                out.append([
+                    Mask2D(frame_id=f.frame_id, label=lab, score=float(sc), mask=m, box=tuple(float(x) for x in b))
+                    for m, b, sc, lab in zip(masks, d.boxes, d.scores, d.labels) if m.any()
+                ])
+        return out
+
+
+class SamPointSegmenter:
+    """PointPromptSegmenter: SAM with positive/negative points; the best of SAM's 3 masks by predicted IoU.
+
+    The last frame's image embedding is kept, so re-segmenting several objects in one view encodes it once.
+    """
+
+    def __init__(self, sam: Loaded) -> None:
+        self.sam = sam
+        self._last: tuple[str, tuple[int, ...], torch.Tensor, dict] | None = None
+
+    def _embed(self, frame: Frame, image: np.ndarray) -> tuple[torch.Tensor, dict]:
+        key = (frame.frame_id, image.shape)
+        if self._last is None or self._last[:2] != key:
+            emb, inputs = sam_image_embeddings(self.sam, [image])
+            self._last = (*key, emb, inputs)
+        return self._last[2], self._last[3]
+
+    def segment_points(self, frame: Frame, image: np.ndarray, points: np.ndarray, labels: np.ndarray) -> Mask2D:
+        points = np.asarray(points, float).reshape(-1, 2)
+        labels = np.asarray(labels, int).reshape(-1)
+        if len(points) == 0 or len(points) != len(labels):
+            raise ValueError(f"need N>0 points with N labels, got {len(points)} points and {len(labels)} labels")
+        prompt = self.sam.processor(images=[image], input_points=[[points.tolist()]], input_labels=[[labels.tolist()]],
+                                    return_tensors="pt")
+        feed = {"input_points": prompt["input_points"].to(self.sam.device, self.sam.dtype),
+                "input_labels": prompt["input_labels"].to(self.sam.device)}
+        with torch.inference_mode():
+            if is_sam2(self.sam):
+                out = self.sam.model(pixel_values=prompt["pixel_values"].to(self.sam.device, self.sam.dtype), **feed,
+                                     multimask_output=True)
+            else:
+                emb, _ = self._embed(frame, image)
+                out = self.sam.model(image_embeddings=emb, **feed, multimask_output=True)
+        best = int(out.iou_scores[0, 0].float().argmax())
+        low = out.pred_masks[:, :, best : best + 1]
+        if is_sam2(self.sam):
+            mask = self.sam.processor.post_process_masks(low.float().cpu(), prompt["original_sizes"])[0][0, 0].numpy()
+        else:
+            mask = masks_to_original(self.sam, low, prompt["original_sizes"][0].tolist(), prompt["reshaped_input_sizes"][0].tolist())[0]
+        ys, xs = np.nonzero(mask)
+        box = (float(xs.min()), float(ys.min()), float(xs.max() + 1), float(ys.max() + 1)) if len(xs) else None
+        return Mask2D(frame_id=frame.frame_id, label="openable", score=float(out.iou_scores[0, 0, best]), mask=mask.astype(bool), box=box)
