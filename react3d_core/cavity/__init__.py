@@ -1,0 +1,164 @@
+"""Hidden geometry behind a movable part: cavity depth d_in = min(d_image, d_hit, d_mesh), the base
+(an open, double-walled box behind the front) and, for drawers, an inner box that moves with the part.
+
+- d_hit: rays from the slab's mid-surface into the cavity (centre and 4 points at 0.1 x the longest
+  edge), starting beyond 2 x the slab thickness so the part itself is not hit; the median hit;
+- d_image: the farthest scene depth behind the front plane seen around the part in the segmenting frame
+  (an upper bound: the wall behind a wall cabinet);
+- d_mesh: where the ray leaves the scan's bounding box.
+Depths are measured from the slab's back face.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..config import CavityConfig
+from ..data.frames import Frame
+from ..data.mesh import TriMesh
+
+STAGE_VERSION = "1"
+
+
+@dataclass
+class PartFrame:
+    """The front slab's frame: centre on the mid-surface, in-plane axes/extents, normal into the cavity."""
+
+    center: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    n: np.ndarray
+    su: float
+    sv: float
+    thickness: float
+
+    @property
+    def back(self) -> np.ndarray:
+        return self.center + self.n * self.thickness / 2
+
+
+def d_hit(pf: PartFrame, cast: callable, cfg: CavityConfig) -> float:  # type: ignore[valid-type]
+    r = cfg.search_radius_factor * max(pf.su, pf.sv)
+    offs = [np.zeros(3), r * pf.u, -r * pf.u, r * pf.v, -r * pf.v]
+    skip = max(cfg.ignore_hits_thickness_factor * pf.thickness, 0.005)
+    origins = np.array([pf.center + o + pf.n * skip for o in offs])
+    t = np.asarray(cast(origins, np.tile(pf.n, (len(origins), 1))), float)
+    t = t[np.isfinite(t)]
+    if len(t) == 0:
+        return np.inf
+    return float(np.median(t) + skip - pf.thickness / 2)
+
+
+def d_mesh(pf: PartFrame, bounds: np.ndarray) -> float:
+    """Distance from the back face along n to the scan's bounding box."""
+    o, n = pf.back, pf.n
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(n > 1e-9, (bounds[1] - o) / n, np.where(n < -1e-9, (bounds[0] - o) / n, np.inf))
+    return float(max(0.0, t.min()))
+
+
+def d_image(pf: PartFrame, frame: Frame | None, depth: np.ndarray | None, cfg: CavityConfig) -> float:
+    """Farthest depth behind the front plane in a band around the part (segmenting frame)."""
+    if frame is None or depth is None or frame.depth_intrinsics is None:
+        return np.inf
+    K = frame.depth_intrinsics.K
+    h, w = depth.shape
+    u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
+    z = depth.astype(float)
+    ok = z > 0
+    pc = np.stack([(u - K[0, 2]) / K[0, 0] * z, (v - K[1, 2]) / K[1, 1] * z, z], -1)[ok]
+    pw = pc @ frame.c2w[:3, :3].T + frame.c2w[:3, 3]
+    rel = pw - pf.back
+    a, b, c = rel @ pf.u, rel @ pf.v, rel @ pf.n
+    band = (np.abs(a) <= 0.65 * pf.su) & (np.abs(b) <= 0.65 * pf.sv) & ~((np.abs(a) <= 0.5 * pf.su) & (np.abs(b) <= 0.5 * pf.sv))
+    behind = c[band & (c > 0.02)]
+    return float(behind.max()) if len(behind) else np.inf
+
+
+def estimate_cavity(pf: PartFrame, cast: callable, bounds: np.ndarray, frame: Frame | None,  # type: ignore[valid-type]
+                    depth: np.ndarray | None, cfg: CavityConfig) -> tuple[float, str, dict[str, float]]:
+    """(d_in, which bound set it, all three bounds)."""
+    terms = {"hit": d_hit(pf, cast, cfg), "image": d_image(pf, frame, depth, cfg), "mesh": d_mesh(pf, bounds)}
+    src = min(terms, key=terms.get)
+    d = terms[src]
+    if not np.isfinite(d) or d <= 0.02:
+        return cfg.default_depth_m, "default", terms
+    if d > cfg.max_depth_m:
+        return cfg.max_depth_m, "max", terms
+    return float(d), src, terms
+
+
+def _box(lo: np.ndarray, hi: np.ndarray, pf: PartFrame, origin: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A closed box [lo, hi] in the part frame (u, v, n) placed at ``origin`` (8 vertices, 12 faces)."""
+    c = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
+    local = lo + c * (hi - lo)
+    R = np.stack([pf.u, pf.v, pf.n], 1)
+    verts = origin + local @ R.T
+    faces = np.array([[0, 1, 2], [1, 3, 2], [4, 6, 5], [5, 6, 7], [0, 4, 1], [1, 4, 5],
+                      [2, 3, 6], [3, 7, 6], [0, 2, 4], [2, 6, 4], [1, 5, 3], [3, 5, 7]])
+    t = verts[faces]
+    nrm = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    out = (nrm * (t.mean(1) - verts.mean(0))).sum(1) < 0  # make every face point away from the centre
+    faces[out] = faces[out][:, ::-1]
+    return verts, faces
+
+
+def _merge(boxes: list[tuple[np.ndarray, np.ndarray]], color: int) -> TriMesh:
+    vs, fs, n = [], [], 0
+    for v, f in boxes:
+        vs.append(v)
+        fs.append(f + n)
+        n += len(v)
+    v = np.concatenate(vs)
+    return TriMesh(v, np.concatenate(fs), np.full((len(v), 3), color, np.uint8))
+
+
+def wall_thickness(pf: PartFrame, cfg: CavityConfig) -> float:
+    return max(cfg.min_wall_m, cfg.wall_factor * min(pf.su, pf.sv))
+
+
+def base_mesh(pf: PartFrame, depth: float, cfg: CavityConfig, gap: float = 0.002) -> TriMesh:
+    """Open-front box behind the front: back wall and four side walls with real thickness."""
+    w = wall_thickness(pf, cfg)
+    hu, hv = pf.su / 2, pf.sv / 2
+    c0, c1 = gap, gap + depth
+    o = pf.back
+    boxes = [
+        _box(np.array([-hu, -hv, c1 - w]), np.array([hu, hv, c1]), pf, o),
+        _box(np.array([-hu, -hv, c0]), np.array([-hu + w, hv, c1 - w]), pf, o),
+        _box(np.array([hu - w, -hv, c0]), np.array([hu, hv, c1 - w]), pf, o),
+        _box(np.array([-hu + w, -hv, c0]), np.array([hu - w, -hv + w, c1 - w]), pf, o),
+        _box(np.array([-hu + w, hv - w, c0]), np.array([hu - w, hv, c1 - w]), pf, o),
+    ]
+    return _merge(boxes, 170)
+
+
+def inner_box_mesh(pf: PartFrame, depth: float, cfg: CavityConfig, up: np.ndarray, gap: float = 0.004) -> TriMesh:
+    """A drawer's open-top box behind its front (moves with it): bottom, back and two sides."""
+    w = wall_thickness(pf, cfg)
+    # the in-plane axis closest to 'up' is the drawer's vertical
+    vert_is_v = abs(np.dot(pf.v, up)) >= abs(np.dot(pf.u, up))
+    hu = pf.su / 2 - w - gap
+    hv = pf.sv / 2 - w - gap
+    d = max(0.02, depth - 2 * w - 2 * gap)
+    c0, c1 = gap, gap + d
+    o = pf.back
+    t = max(0.004, w * 0.6)
+    sgn = np.sign(np.dot(pf.v if vert_is_v else pf.u, up)) or 1.0
+    if vert_is_v:
+        bottom = (np.array([-hu, -hv, c0]), np.array([hu, -hv + t, c1])) if sgn > 0 else (np.array([-hu, hv - t, c0]), np.array([hu, hv, c1]))
+        h = 0.7 * 2 * hv
+        zlo, zhi = (-hv, -hv + h) if sgn > 0 else (hv - h, hv)
+        walls = [(np.array([-hu, zlo, c1 - t]), np.array([hu, zhi, c1])),
+                 (np.array([-hu, zlo, c0]), np.array([-hu + t, zhi, c1 - t])),
+                 (np.array([hu - t, zlo, c0]), np.array([hu, zhi, c1 - t]))]
+    else:
+        bottom = (np.array([-hu, -hv, c0]), np.array([-hu + t, hv, c1])) if sgn > 0 else (np.array([hu - t, -hv, c0]), np.array([hu, hv, c1]))
+        h = 0.7 * 2 * hu
+        zlo, zhi = (-hu, -hu + h) if sgn > 0 else (hu - h, hu)
+        walls = [(np.array([zlo, -hv, c1 - t]), np.array([zhi, hv, c1])),
+                 (np.array([zlo, -hv, c0]), np.array([zhi, -hv + t, c1 - t])),
+                 (np.array([zlo, hv - t, c0]), np.array([zhi, hv, c1 - t]))]
+    return _merge([_box(lo, hi, pf, o) for lo, hi in [bottom, *walls]], 150)
