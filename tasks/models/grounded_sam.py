@@ -25,10 +25,13 @@ def detector_prompt(phrases: Sequence[str]) -> str:
     return " ".join(p.strip().lower().rstrip(".") + "." for p in phrases if p.strip())
 
 
+_SPECIAL = {"[cls]", "[sep]", "[pad]", "[unk]", "[mask]", "<s>", "</s>", "<pad>", "<unk>"}
+
+
 def match_phrase(label: str, phrases: Sequence[str]) -> str:
     """Map a decoded Grounding DINO label (sub-phrase tokens) to the prompt phrase sharing most words."""
-    words = set(label.lower().replace(".", " ").split())
-    best, best_n = label.strip() or (phrases[0] if phrases else "openable"), 0
+    words = set(label.lower().replace(".", " ").split()) - _SPECIAL
+    best, best_n = " ".join(w for w in label.lower().split() if w not in _SPECIAL) or "openable", 0
     for p in phrases:
         n = len(words & set(p.lower().split()))
         if n > best_n:
@@ -68,7 +71,7 @@ def detect(det: Loaded, images: Sequence[np.ndarray], phrases: Sequence[str],
         boxes[:, [0, 2]] = boxes[:, [0, 2]].clip(0, w)
         boxes[:, [1, 3]] = boxes[:, [1, 3]].clip(0, h)
         keep = (boxes[:, 2] - boxes[:, 0] >= 1) & (boxes[:, 3] - boxes[:, 1] >= 1)
-        labels = r.get("text_labels", r.get("labels", []))
+        labels = r["text_labels"] if "text_labels" in r else r.get("labels", [])
         dets.append(Detection(boxes[keep], r["scores"].detach().cpu().numpy()[keep].astype(float),
                               [match_phrase(str(l), phrases) for l, k in zip(labels, keep) if k]))
     return dets

@@ -52,9 +52,9 @@ class ClipTagger:
             px = self.clip.processor(images=list(images[s : s + self.batch_size]), return_tensors="pt")["pixel_values"]
             with torch.inference_mode():
                 v = self.clip.model.get_image_features(pixel_values=px.to(self.clip.device, self.clip.dtype))
-            v = torch.nn.functional.normalize(getattr(v, "pooler_output", v).float(), dim=-1)
-            scale = self.clip.model.logit_scale.exp().float()
-            rows.append(torch.softmax(scale * v @ text.T, dim=-1).cpu().numpy())
+                v = torch.nn.functional.normalize(getattr(v, "pooler_output", v).float(), dim=-1)
+                scale = self.clip.model.logit_scale.exp().float()
+                rows.append(torch.softmax(scale * v @ text.T, dim=-1).cpu().numpy())
         return np.concatenate(rows) if rows else np.zeros((0, len(self.vocabulary)))
 
     def tag(self, frames: Sequence[Frame], images: Sequence[np.ndarray]) -> list[list[str]]:

@@ -1,0 +1,93 @@
+"""Grounded-SAM / SAM adapters on tiny random checkpoints: batching, sizes, coordinates, thresholds."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, detect, detector_prompt,
+                                       masks_to_original, match_phrase)
+from tasks.models.loaders import load_detector, load_sam
+
+SIZES = [(48, 64), (96, 128), (60, 80)]
+
+
+@pytest.fixture(scope="module")
+def loaded(tiny_models):
+    cpu = torch.device("cpu")
+    return load_detector(str(tiny_models["detector"]), cpu, torch.float32), load_sam(str(tiny_models["sam"]), cpu, torch.float32)
+
+
+def test_detector_prompt_and_phrase_matching():
+    assert detector_prompt(["Cabinet door", "door.", " "]) == "cabinet door. door."
+    assert match_phrase("cabinet", ["door", "cabinet door"]) == "cabinet door"
+    assert match_phrase("[CLS] door [SEP]", ["oven door", "door"]) == "oven door"  # first phrase with most shared words
+    assert match_phrase("[UNK]", ["door"]) == "openable"
+
+
+def test_segment_batches_and_returns_masks_at_frame_size(loaded, make_frame, make_image):
+    det, sam = loaded
+    frames = [make_frame(f"f{i}", h, w) for i, (h, w) in enumerate(SIZES)]
+    images = [make_image(h, w, i) for i, (h, w) in enumerate(SIZES)]
+    seg = GroundedSamSegmenter(det, sam, box_threshold=0.0, text_threshold=0.0, batch_size=2)
+    out = seg.segment(frames, images, ["cabinet door", "door"])
+    assert len(out) == 3
+    for f, (h, w), masks in zip(frames, SIZES, out):
+        assert masks, "threshold 0 must keep the detector's queries"
+        for m in masks:
+            assert m.frame_id == f.frame_id and m.mask.shape == (h, w) and m.mask.dtype == bool
+            x0, y0, x1, y1 = m.box
+            assert 0 <= x0 < x1 <= w and 0 <= y0 < y1 <= h
+            assert m.label in ("cabinet door", "door")
+    # batching must not change results: one frame at a time gives the same boxes
+    single = GroundedSamSegmenter(det, sam, 0.0, 0.0, batch_size=1).segment(frames[1:2], images[1:2], ["cabinet door", "door"])
+    got = sorted(m.box for m in out[1])
+    ref = sorted(m.box for m in single[0])
+    np.testing.assert_allclose(np.array(got), np.array(ref), atol=0.5)
+
+
+def test_thresholds_are_applied(loaded, make_frame, make_image):
+    det, sam = loaded
+    im = [make_image(60, 80, 0)]
+    all_dets = detect(det, im, ["door"], 0.0, 0.0)[0]
+    strict = detect(det, im, ["door"], 0.3, 0.25)[0]
+    assert (strict.scores >= 0.3).all()
+    assert len(strict.boxes) == int((all_dets.scores >= 0.3).sum())
+    assert GroundedSamSegmenter(det, sam, 1.0, 1.0, 4).segment([make_frame("a", 60, 80)], im, ["door"]) == [[]]
+    assert GroundedSamSegmenter(det, sam, 0.0, 0.0, 4).segment([make_frame("a", 60, 80)], im, []) == [[]]
+
+
+def test_low_res_mask_maps_back_to_rescaled_image(loaded):
+    """Hand-computed: a 128x96 image is resized by 0.5 to 64x48 inside SAM's 64x64 padded input; the
+    32x32 low-res mask is 2 px/cell there, so cells rows 4..11, cols 8..15 -> padded px rows 8..23,
+    cols 16..31 -> original px rows 16..47, cols 32..63."""
+    _, sam = loaded
+    low = torch.full((1, 1, 1, 32, 32), -10.0)
+    low[..., 4:12, 8:16] = 10.0
+    m = masks_to_original(sam, low, (96, 128), (48, 64))[0]
+    expect = np.zeros((96, 128), bool)
+    expect[16:48, 32:64] = True
+    assert m.shape == (96, 128)
+    iou = (m & expect).sum() / (m | expect).sum()
+    assert iou > 0.9
+
+
+def test_box_prompt_is_rescaled_like_the_image(loaded, make_frame, make_image):
+    """A box (x0,y0,x1,y1)=(20,10,100,60) on a 128x96 image is 0.5x in SAM's 64-px input."""
+    _, sam = loaded
+    p = sam.processor(images=[make_image(96, 128, 0)], input_boxes=[[[20, 10, 100, 60]]], return_tensors="pt")
+    np.testing.assert_allclose(p["input_boxes"][0, 0].numpy(), [10, 5, 50, 30])
+
+
+def test_point_segmenter_reuses_embedding(loaded, make_frame, make_image):
+    _, sam = loaded
+    ps = SamPointSegmenter(sam)
+    f, im = make_frame("p", 96, 128), make_image(96, 128, 1)
+    m1 = ps.segment_points(f, im, np.array([[60, 40], [5, 5]]), np.array([1, 0]))
+    emb = ps._last[2]
+    m2 = ps.segment_points(f, im, np.array([[30, 30]]), np.array([1]))
+    assert ps._last[2] is emb
+    assert m1.mask.shape == m2.mask.shape == (96, 128) and 0.0 <= m1.score
+    with pytest.raises(ValueError):
+        ps.segment_points(f, im, np.zeros((2, 2)), np.array([1]))
