@@ -1,0 +1,81 @@
+"""make_model_perception end to end on tiny checkpoints: load once, all five calls, clear errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import torch
+
+from react3d_core.config import PerceptionConfig
+from react3d_core.perception.interfaces import (ArticulationPredictor, PointPromptSegmenter, Tagger, TagFilter,
+                                                TextPromptSegmenter)
+from tasks.models import STAGE_VERSION, ModelUnavailableError, make_model_perception
+from tasks.models.options import ModelOptions, model_options
+from tasks.models.runtime import cached_keys, resolve_device, resolve_dtype
+from tasks.models.tagger import select_tags
+
+
+def _chat(i, body):
+    return 200, json.dumps({"choices": [{"message": {"content": '["cabinet", "drawer"]'}}]}).encode(), 0
+
+
+def _opd(i, body):
+    preds = [{"frame_id": f["frame_id"], "joint_type": "revolute", "axis": [0, 1, 0], "origin": [0, 0, 1], "score": 0.9,
+              "box": [2, 2, 20, 20]} for f in body["frames"]]
+    return 200, json.dumps({"predictions": preds}).encode(), 0
+
+
+def test_full_backend_on_tiny_models(tiny_models, fake_server, make_frame, make_image):
+    chat, opd = fake_server(_chat), fake_server(_opd)
+    cfg = PerceptionConfig(backend="models", detector_model=str(tiny_models["detector"]), sam_model=str(tiny_models["sam"]),
+                           tagger_model=str(tiny_models["clip"]), tag_filter_endpoint=chat.url + "/v1",
+                           articulation_endpoint=opd.url, box_threshold=0.0, text_threshold=0.0, batch_size=2, device="cpu")
+    p = make_model_perception(cfg)
+    assert p.name == "models" and p.version == STAGE_VERSION
+    for obj, proto in [(p.tagger, Tagger), (p.tag_filter, TagFilter), (p.segmenter, TextPromptSegmenter),
+                       (p.point_segmenter, PointPromptSegmenter), (p.articulation, ArticulationPredictor)]:
+        assert isinstance(obj, proto)
+    frames = [make_frame(f"f{i}", 48 + 12 * i, 64 + 16 * i) for i in range(3)]
+    images = [make_image(48 + 12 * i, 64 + 16 * i, i) for i in range(3)]
+    tags = p.tagger.tag(frames, images)
+    assert len(tags) == 3 and all(1 <= len(t) <= 8 for t in tags)
+    assert p.tag_filter.filter(["cabinet", "door", "table"]) == ["cabinet", "door"]
+    masks = p.segmenter.segment(frames, images, ["cabinet door", "door"])
+    assert [m[0].mask.shape for m in masks] == [im.shape[:2] for im in images]
+    pm = p.point_segmenter.segment_points(frames[0], images[0], np.array([[30, 20]]), np.array([1]))
+    assert pm.mask.shape == (48, 64)
+    arts = p.articulation.predict(frames, images)
+    assert [len(a) for a in arts] == [1, 1, 1] and arts[2][0].frame_id == "f2"
+    assert [len(r["body"]["frames"]) for r in opd.requests] == [2, 1]  # batched by config.batch_size
+    # loaded once per worker: a second backend reuses the same model objects
+    n = len(cached_keys())
+    p2 = make_model_perception(cfg)
+    assert len(cached_keys()) == n and p2.segmenter.sam is p.segmenter.sam
+
+
+def test_missing_weights_is_one_clear_line(tmp_path):
+    cfg = PerceptionConfig(backend="models", detector_model=str(tmp_path / "no-gdino"), device="cpu")
+    with pytest.raises(ModelUnavailableError) as ei:
+        make_model_perception(cfg)
+    msg = str(ei.value)
+    assert "\n" not in msg and "Grounding DINO" in msg and "no-gdino" in msg and "perception.detector_model" in msg
+    cfg2 = PerceptionConfig(backend="models", detector_model="IDEA-Research/grounding-dino-tiny-not-cached", device="cpu")
+    with pytest.raises(ModelUnavailableError, match="HF_HUB_OFFLINE=1.*huggingface-cli download"):
+        make_model_perception(cfg2)
+
+
+def test_device_dtype_and_options():
+    cpu = torch.device("cpu")
+    assert resolve_device("cpu") == cpu and resolve_dtype("auto", cpu) == torch.float32
+    assert resolve_dtype("bf16", cpu) == torch.bfloat16
+    if not torch.cuda.is_available():
+        assert resolve_device("auto") == cpu
+    assert model_options(PerceptionConfig()) == ModelOptions()
+
+
+def test_select_tags_hand_computed():
+    probs = np.array([[0.5, 0.3, 0.15, 0.05], [0.01, 0.01, 0.9, 0.08]])
+    assert select_tags(probs, ["a", "b", "c", "d"], top_k=3, min_prob=0.1) == [["a", "b", "c"], ["c"]]
+    assert select_tags(probs, ["a", "b", "c", "d"], top_k=1, min_prob=0.0) == [["a"], ["c"]]
