@@ -25,8 +25,11 @@ class _Encoder:
     def __init__(self) -> None:
         self.arrays: dict[str, np.ndarray] = {}
 
-    def _array(self, a: np.ndarray) -> dict[str, str]:
+    def _array(self, a: np.ndarray) -> dict[str, Any]:
         key = f"a{len(self.arrays)}"
+        if a.dtype == bool:  # masks: 8x smaller packed
+            self.arrays[key] = np.packbits(a.ravel())
+            return {"__bits__": key, "shape": list(a.shape)}
         self.arrays[key] = a
         return {"__nd__": key}
 
@@ -77,6 +80,9 @@ def _dec(x: Any, arrays: Any) -> Any:
         return x
     if "__nd__" in x:
         return arrays[x["__nd__"]]
+    if "__bits__" in x:
+        shape = tuple(x["shape"])
+        return np.unpackbits(arrays[x["__bits__"]], count=int(np.prod(shape))).astype(bool).reshape(shape)
     if "__path__" in x:
         return Path(x["__path__"])
     if "__tuple__" in x:

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -36,12 +37,20 @@ def put(obj: Any, kind: str) -> dict[str, str]:
 
 
 def get(handle: dict[str, str]) -> Any:
-    """Load the object behind a handle (clear error if the store was cleaned under a cached record)."""
+    """Load the object behind a handle (clear error if the store was cleaned under a cached record).
+
+    The last few decoded objects are kept per process: per-part tasks read the same perception results.
+    """
     path = Path(handle["path"])
     if not path.is_file():
         raise InputError(path, f"cached {handle.get('kind', 'result')} is gone from the store; "
                                "run `react3d cache clean` (drops stale records) and convert again")
-    return loads(path.read_bytes())
+    return _get_cached(handle["sha256"], str(path))
+
+
+@lru_cache(maxsize=24)
+def _get_cached(sha: str, path: str) -> Any:
+    return loads(Path(path).read_bytes())
 
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
