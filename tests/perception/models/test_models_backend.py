@@ -79,3 +79,20 @@ def test_select_tags_hand_computed():
     probs = np.array([[0.5, 0.3, 0.15, 0.05], [0.01, 0.01, 0.9, 0.08]])
     assert select_tags(probs, ["a", "b", "c", "d"], top_k=3, min_prob=0.1) == [["a", "b", "c"], ["c"]]
     assert select_tags(probs, ["a", "b", "c", "d"], top_k=1, min_prob=0.0) == [["a"], ["c"]]
+
+
+def test_benchmark_runs_tiny(tmp_path):
+    """benchmarks/bench_models.py end to end on tiny configs (CPU): table + JSON with the three columns."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "bench_models.py"
+    spec = importlib.util.spec_from_file_location("bench_models", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = tmp_path / "b.json"
+    assert mod.main(["--tiny", "--images", "2", "--batch", "2", "--rebuild-calls", "1", "--models", "gdino_t,sam_vit_b",
+                     "--json", str(out)]) == 0
+    rows = json.loads(out.read_text())["rows"]
+    assert [r["model"] for r in rows] == ["gdino_t", "sam_vit_b"]
+    assert all(r["ours_img_s"] > 0 and r["ref_fp32_b1_img_s"] > 0 and r["ref_rebuild_img_s"] > 0 for r in rows)

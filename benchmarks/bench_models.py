@@ -1,0 +1,163 @@
+"""Perception-model throughput: reference-style calls versus the tasks/models way of calling them.
+
+    python3 benchmarks/bench_models.py --json bench_models.json            # GPU: real architectures
+    python3 benchmarks/bench_models.py --tiny --json bench_models.json     # CPU smoke run, tiny configs
+
+Models are built from configs with random weights (nothing is downloaded): SAM ViT-H and ViT-B image
+encoders at 1024x1024, Grounding DINO-T (Swin-T + BERT-base, transformers' default config) at
+800x1066 with a 16-token prompt. For each model:
+  * reference: fp32, batch 1, the model built anew for every call (as per-frame scripts do);
+    reported both as forward-only img/s and img/s including the rebuild;
+  * ours: built once, bf16 on GPU (fp32 on CPU), batches of --batch frames, torch.inference_mode.
+Prints a table and writes JSON. Without a GPU the real sizes take minutes per call, so ``--tiny``
+(automatic on CPU unless --full) uses few-layer configs: the numbers then only show the code runs.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from react3d_core.atomic import write_json  # noqa: E402
+
+
+def sam_spec(variant: str, tiny: bool) -> tuple[Callable[[], Any], Callable[[Any, int, Any, Any], Any]]:
+    """(build, run) for a SAM image encoder; run(model, batch, device, dtype) does one forward."""
+    import torch
+    from transformers import SamConfig, SamModel
+
+    if tiny:
+        vc = dict(hidden_size=64, num_hidden_layers=2, num_attention_heads=2, image_size=256, patch_size=16,
+                  output_channels=32, global_attn_indexes=[1], window_size=4, num_pos_feats=16)
+    else:
+        vc = {"vit_h": dict(hidden_size=1280, num_hidden_layers=32, num_attention_heads=16, global_attn_indexes=[7, 15, 23, 31]),
+              "vit_b": dict(hidden_size=768, num_hidden_layers=12, num_attention_heads=12, global_attn_indexes=[2, 5, 8, 11])}[variant]
+    cfg = SamConfig(vision_config=vc, prompt_encoder_config=dict(hidden_size=vc.get("output_channels", 256),
+                                                                 image_size=vc.get("image_size", 1024), patch_size=vc.get("patch_size", 16)))
+    size = cfg.vision_config.image_size
+
+    def build() -> Any:
+        return SamModel(cfg).eval()
+
+    def run(model: Any, batch: int, device: Any, dtype: Any) -> Any:
+        x = torch.randn(batch, 3, size, size, device=device, dtype=dtype)
+        return model.get_image_embeddings(x)
+
+    return build, run
+
+
+def gdino_spec(tiny: bool) -> tuple[Callable[[], Any], Callable[[Any, int, Any, Any], Any]]:
+    import torch
+    from transformers import BertConfig, GroundingDinoConfig, GroundingDinoForObjectDetection, SwinConfig
+
+    if tiny:
+        cfg = GroundingDinoConfig(
+            backbone_config=SwinConfig(image_size=64, patch_size=4, embed_dim=16, depths=[1, 1, 1, 1], num_heads=[1, 1, 1, 1],
+                                       window_size=4, out_indices=[2, 3, 4]),
+            text_config=BertConfig(vocab_size=64, hidden_size=32, num_hidden_layers=1, num_attention_heads=2,
+                                   intermediate_size=32, max_position_embeddings=64),
+            d_model=32, encoder_layers=1, decoder_layers=2, encoder_ffn_dim=32, decoder_ffn_dim=32, encoder_attention_heads=2,
+            decoder_attention_heads=2, num_queries=50, encoder_n_points=2, decoder_n_points=2, max_text_len=32)
+        hw = (96, 128)
+    else:
+        cfg, hw = GroundingDinoConfig(), (800, 1066)  # defaults = Grounding DINO-T (Swin-T, BERT-base, 900 queries)
+
+    def build() -> Any:
+        return GroundingDinoForObjectDetection(cfg).eval()
+
+    def run(model: Any, batch: int, device: Any, dtype: Any) -> Any:
+        g = torch.Generator().manual_seed(0)
+        ids = torch.randint(1000 if not tiny else 5, cfg.text_config.vocab_size, (batch, 16), generator=g).to(device)
+        x = torch.randn(batch, 3, *hw, device=device, dtype=dtype)
+        return model(pixel_values=x, input_ids=ids, attention_mask=torch.ones_like(ids))
+
+    return build, run
+
+
+def timed(fn: Callable[[], Any], device: Any) -> float:
+    import torch
+
+    if device.type == "cuda":
+        torch.cuda.synchronize(device)
+    t = time.perf_counter()
+    fn()
+    if device.type == "cuda":
+        torch.cuda.synchronize(device)
+    return time.perf_counter() - t
+
+
+def bench_one(name: str, build: Callable[[], Any], run: Callable[..., Any], device: Any, dtype: Any,
+              batch: int, n_images: int, rebuild_calls: int) -> dict[str, Any]:
+    """Reference (fp32, batch 1, rebuilt per call) versus ours (built once, dtype, batched)."""
+    import torch
+
+    with torch.inference_mode():
+        # reference forward-only: fp32, batch 1 (model built once here so only the forward is timed)
+        ref = build().to(device)
+        run(ref, 1, device, torch.float32)  # warm-up
+        t_fwd = sum(timed(lambda: run(ref, 1, device, torch.float32), device) for _ in range(n_images))
+        del ref
+        # reference with rebuild per call
+        t_rb = sum(timed(lambda: run(build().to(device), 1, device, torch.float32), device) for _ in range(rebuild_calls))
+        ours = build().to(device=device, dtype=dtype)
+        run(ours, batch, device, dtype)  # warm-up
+        n_batches = max(1, n_images // batch)
+        t_ours = sum(timed(lambda: run(ours, batch, device, dtype), device) for _ in range(n_batches))
+        del ours
+    if device.type == "cuda":
+        torch.cuda.empty_cache()
+    row = {"model": name, "ref_fp32_b1_img_s": n_images / t_fwd, "ref_rebuild_img_s": rebuild_calls / t_rb,
+           "ours_img_s": n_batches * batch / t_ours, "batch": batch, "dtype": str(dtype).replace("torch.", "")}
+    row["speedup_vs_ref"] = row["ours_img_s"] / row["ref_fp32_b1_img_s"]
+    return row
+
+
+def main(argv: list[str] | None = None) -> int:
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--tiny", action="store_true", help="few-layer configs (automatic without a GPU unless --full)")
+    p.add_argument("--full", action="store_true", help="real sizes even on CPU (slow)")
+    p.add_argument("--batch", type=int, default=8)
+    p.add_argument("--images", type=int, default=16, help="images per measurement")
+    p.add_argument("--rebuild-calls", type=int, default=2)
+    p.add_argument("--models", default="sam_vit_h,sam_vit_b,gdino_t")
+    p.add_argument("--dtype", default="auto", help="ours: auto (bf16 on GPU, fp32 on CPU), bf16, fp16, fp32")
+    p.add_argument("--json", default=None)
+    a = p.parse_args(argv)
+
+    import torch
+    from rich.console import Console
+    from rich.table import Table
+
+    from tasks.models.runtime import resolve_dtype
+
+    torch.manual_seed(0)
+    device = torch.device("cuda" if torch.cuda.is_available() else "cpu")
+    tiny = a.tiny or (device.type == "cpu" and not a.full)
+    dtype = resolve_dtype(a.dtype, device)
+    specs = {"sam_vit_h": lambda: sam_spec("vit_h", tiny), "sam_vit_b": lambda: sam_spec("vit_b", tiny),
+             "gdino_t": lambda: gdino_spec(tiny)}
+    rows = []
+    for name in a.models.split(","):
+        build, run = specs[name.strip()]()
+        rows.append(bench_one(name.strip(), build, run, device, dtype, a.batch, a.images, a.rebuild_calls))
+    dev_name = torch.cuda.get_device_name(device) if device.type == "cuda" else "cpu"
+    table = Table(title=f"perception models on {dev_name}{' (tiny configs)' if tiny else ''}")
+    for c in ("model", "ref fp32 b1 img/s", "ref +rebuild img/s", f"ours {rows[0]['dtype'] if rows else ''} b{a.batch} img/s", "speedup"):
+        table.add_column(c)
+    for r in rows:
+        table.add_row(r["model"], f"{r['ref_fp32_b1_img_s']:.2f}", f"{r['ref_rebuild_img_s']:.2f}", f"{r['ours_img_s']:.2f}",
+                      f"{r['speedup_vs_ref']:.1f}x")
+    Console().print(table)
+    if a.json:
+        write_json(a.json, {"device": dev_name, "tiny": tiny, "torch": torch.__version__, "rows": rows})
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
