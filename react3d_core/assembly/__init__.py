@@ -43,9 +43,8 @@ class _Geometry:
         rays = np.concatenate([origins, dirs], 1).astype(np.float32)
         return self.scene.cast_rays(self._o3d.core.Tensor(rays))["t_hit"].numpy()
 
-    def distance_excluding(self, own_faces: np.ndarray, n_faces: int):  # noqa: ANN201
-        own = np.zeros(n_faces, bool)
-        own[own_faces] = True
+    def distance_excluding(self, own: np.ndarray):  # noqa: ANN201
+        """Distance to the scan, ignoring faces flagged in ``own`` (the part and what is attached to it)."""
 
         def dist(points: np.ndarray) -> np.ndarray:
             ans = self.scene.compute_closest_points(self._o3d.core.Tensor(np.asarray(points, np.float32)))
@@ -53,6 +52,17 @@ class _Geometry:
             return np.where(own[ans["primitive_ids"].numpy().astype(np.int64)], np.inf, d)
 
         return dist
+
+
+def attached_faces(mesh: TriMesh, p: ArticulatedPart, pf: PartFrame, reach: float = 0.1) -> np.ndarray:
+    """Faces that move with the part: its own, and hardware in front of it within its outline
+    (a handle the segmentation left out), up to ``reach`` into the room."""
+    own = np.zeros(mesh.n_faces, bool)
+    own[p.face_ids] = True
+    c = mesh.vertices[mesh.faces].mean(1) - pf.center
+    a, b, d = c @ pf.u, c @ pf.v, c @ pf.n
+    own |= (np.abs(a) <= pf.su / 2) & (np.abs(b) <= pf.sv / 2) & (d > -reach) & (d < pf.thickness / 2 + 0.002)
+    return own
 
 
 def carve_background(mesh: TriMesh, parts: list[ArticulatedPart], margin: float) -> np.ndarray:
@@ -94,7 +104,7 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
         pts = mesh.vertices[p.vertex_ids]
         if len(pts) > 600:
             pts = pts[rng.choice(len(pts), 600, replace=False)]
-        art = set_limits(p.articulation, pts, pf.n, d_in, geo.distance_excluding(p.face_ids, mesh.n_faces), config.limits)
+        art = set_limits(p.articulation, pts, pf.n, d_in, geo.distance_excluding(attached_faces(mesh, p, pf)), config.limits)
         odir = out / "meshes" / oid
         part_mesh, _ = mesh.submesh(p.face_ids)
         save_mesh(odir / "part.ply", part_mesh)

@@ -4,7 +4,7 @@
 - d_hit: rays from the slab's mid-surface into the cavity (centre and 4 points at 0.1 x the longest
   edge), starting beyond 2 x the slab thickness so the part itself is not hit; the median hit;
 - d_image: the farthest scene depth behind the front plane seen around the part in the segmenting frame
-  (an upper bound: the wall behind a wall cabinet);
+  (an upper bound: the wall behind a wall cabinet), used when at least 20 % of that band lies behind;
 - d_mesh: where the ray leaves the scan's bounding box.
 Depths are measured from the slab's back face.
 """
@@ -74,7 +74,11 @@ def d_image(pf: PartFrame, frame: Frame | None, depth: np.ndarray | None, cfg: C
     a, b, c = rel @ pf.u, rel @ pf.v, rel @ pf.n
     band = (np.abs(a) <= 0.65 * pf.su) & (np.abs(b) <= 0.65 * pf.sv) & ~((np.abs(a) <= 0.5 * pf.su) & (np.abs(b) <= 0.5 * pf.sv))
     behind = c[band & (c > 0.02)]
-    return float(behind.max()) if len(behind) else np.inf
+    # only a real view of what lies behind (a wall around a wall cabinet) bounds the depth; a sliver of
+    # plinth recess or a gap does not
+    if band.sum() == 0 or len(behind) < 0.2 * band.sum():
+        return np.inf
+    return float(behind.max())
 
 
 def estimate_cavity(pf: PartFrame, cast: callable, bounds: np.ndarray, frame: Frame | None,  # type: ignore[valid-type]
