@@ -48,9 +48,11 @@ def make_model_perception(config: PerceptionConfig) -> Perception:
     if config.tag_filter_endpoint:
         ask = chat_asker(config.tag_filter_endpoint, config.tag_filter_model, opts.llm_timeout_s, opts.llm_retries,
                          opts.llm_backoff_s, api_key=os.environ.get("REACT3D_LLM_API_KEY") or os.environ.get("OPENAI_API_KEY"))
+        retries = opts.llm_retries
     else:
         lm = load_cached("lm", config.tag_filter_model, device, dtype, load_causal_lm, "tag-filter language model", "tag_filter_model")
         ask = local_lm_asker(lm, opts.llm_max_new_tokens)
+        retries = 0  # greedy decoding: asking again gives the same reply
     articulation: ArticulationPredictor
     if config.articulation_endpoint:
         articulation = OPDMultiClient(config.articulation_endpoint, opts.articulation_timeout_s, opts.articulation_min_score,
@@ -60,7 +62,7 @@ def make_model_perception(config: PerceptionConfig) -> Perception:
     return Perception(
         name="models",
         tagger=ClipTagger(clip, opts.tag_vocabulary, opts.tag_top_k, opts.tag_min_prob, config.batch_size),
-        tag_filter=CachedTagFilter(ask, config.always_keep_tags, opts.llm_retries, opts.llm_backoff_s),
+        tag_filter=CachedTagFilter(ask, config.always_keep_tags, retries, opts.llm_backoff_s),
         segmenter=GroundedSamSegmenter(det, sam, config.box_threshold, config.text_threshold, config.batch_size),
         point_segmenter=SamPointSegmenter(sam),
         articulation=articulation,

@@ -113,6 +113,15 @@ def parse_response(doc: Any, frames: Sequence[Frame], images: Sequence[np.ndarra
     return [by_frame[f.frame_id] for f in frames]
 
 
+def prediction_to_world(pred: ArticulationPrediction, frame: Frame) -> tuple[np.ndarray, np.ndarray | None]:
+    """(axis, origin) of a camera-frame prediction in world coordinates: axis rotated by the pose,
+    origin transformed as a point (None when OPDMulti gave only a pixel; depth lifts that later)."""
+    c2w = frame.c2w
+    axis = c2w[:3, :3] @ np.asarray(pred.axis_cam, float)
+    origin = None if pred.origin_cam is None else c2w[:3, :3] @ np.asarray(pred.origin_cam, float) + c2w[:3, 3]
+    return axis / np.linalg.norm(axis), origin
+
+
 class OPDMultiClient:
     """ArticulationPredictor over the JSON contract: 'http(s)://…' is POSTed to, anything else is a command."""
 

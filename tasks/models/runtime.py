@@ -82,8 +82,11 @@ def load_cached(kind: str, model_id: str, device: torch.device, dtype: torch.dty
         if key not in _CACHE:
             try:
                 _CACHE[key] = loader(model_id, device, dtype)
-            except (OSError, ValueError, EnvironmentError) as exc:
+            except (OSError, ValueError) as exc:
                 raise ModelUnavailableError(missing_weights_message(what, model_id, config_field, exc)) from None
+            except ImportError as exc:
+                first = next((ln.strip() for ln in str(exc).splitlines() if ln.strip()), type(exc).__name__)
+                raise ModelUnavailableError(f"{what} {model_id!r} needs a package that is not installed: {first}") from None
             log.info("loaded %s %s on %s (%s)", kind, model_id, device, dtype)
         return _CACHE[key]
 

@@ -143,10 +143,13 @@ def local_lm_asker(lm: Loaded, max_new_tokens: int) -> Callable[[list[str]], str
             text = tok.apply_chat_template(messages, tokenize=False, add_generation_prompt=True)
         else:
             text = SYSTEM_PROMPT + "\n\n" + filter_prompt(tags) + "\nAnswer: "
-        enc = tok(text, return_tensors="pt").to(lm.device)
+        enc = tok(text=text, return_tensors="pt")
+        ids, att = enc["input_ids"].to(lm.device), enc["attention_mask"].to(lm.device)
+        inner = getattr(tok, "tokenizer", tok)
+        pad = inner.pad_token_id if inner.pad_token_id is not None else inner.eos_token_id
         with torch.inference_mode():
-            out = lm.model.generate(**enc, max_new_tokens=max_new_tokens, do_sample=False,
-                                    pad_token_id=tok.pad_token_id if tok.pad_token_id is not None else tok.eos_token_id)
-        return tok.decode(out[0, enc["input_ids"].shape[1]:], skip_special_tokens=True)
+            out = lm.model.generate(input_ids=ids, attention_mask=att, max_new_tokens=max_new_tokens, do_sample=False,
+                                    pad_token_id=pad)
+        return inner.decode(out[0, ids.shape[1]:], skip_special_tokens=True)
 
     return ask

@@ -96,3 +96,24 @@ def test_benchmark_runs_tiny(tmp_path):
     rows = json.loads(out.read_text())["rows"]
     assert [r["model"] for r in rows] == ["gdino_t", "sam_vit_b"]
     assert all(r["ours_img_s"] > 0 and r["ref_fp32_b1_img_s"] > 0 and r["ref_rebuild_img_s"] > 0 for r in rows)
+
+
+def test_local_lm_tag_filter_path(tmp_path):
+    """A tiny random Llama through the local-LM path: loads, generates, decodes; its gibberish is
+    unreadable, so only 'door' survives (the documented fallback)."""
+    import transformers as tf
+
+    from tasks.models.loaders import load_causal_lm
+    from tasks.models.tag_filter import CachedTagFilter, local_lm_asker
+
+    words = "[PAD] [UNK] [CLS] [SEP] [MASK] . [ ] , cabinet door drawer table".split()
+    torch.manual_seed(0)
+    cfg = tf.LlamaConfig(vocab_size=len(words), hidden_size=16, intermediate_size=32, num_hidden_layers=1, num_attention_heads=2,
+                         num_key_value_heads=2, max_position_embeddings=512, pad_token_id=0, bos_token_id=2, eos_token_id=3)
+    tf.LlamaForCausalLM(cfg).save_pretrained(tmp_path)
+    tf.BertTokenizer(vocab={w: i for i, w in enumerate(words)}).save_pretrained(tmp_path)
+    lm = load_causal_lm(str(tmp_path), torch.device("cpu"), torch.float32)
+    ask = local_lm_asker(lm, max_new_tokens=8)
+    reply = ask(["cabinet", "table"])
+    assert isinstance(reply, str)
+    assert CachedTagFilter(ask, ("door",), retries=0, backoff_s=0).filter(["cabinet", "door", "table"]) == ["door"]

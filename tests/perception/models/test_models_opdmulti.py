@@ -91,3 +91,21 @@ def test_png_round_trip():
     rgb[..., 0] = 255  # red in RGB must stay red
     back = cv2.imdecode(np.frombuffer(base64.b64decode(encode_png(rgb)), np.uint8), cv2.IMREAD_COLOR)
     assert (back[..., 2] == 255).all() and (back[..., 0] == 0).all()
+
+
+def test_prediction_to_world_hand_computed(make_frame):
+    """Camera 90 deg about world z, at (1, 2, 0.5): camera x -> world y, so axis (1,0,0) -> (0,1,0) and
+    origin (0.5, 0, 2) -> R @ o + t = (0, 0.5, 2) + (1, 2, 0.5) = (1, 2.5, 2.5)."""
+    from react3d_core.data.frames import Frame
+    from react3d_core.data.masks import ArticulationPrediction
+    from tasks.models.opdmulti import prediction_to_world
+
+    pose = np.array([[0, -1, 0, 1], [1, 0, 0, 2], [0, 0, 1, 0.5], [0, 0, 0, 1]], float)
+    f = Frame(**{**make_frame("w", 4, 4).model_dump(), "pose": pose})
+    pred = ArticulationPrediction(frame_id="w", mask=np.ones((4, 4), bool), joint_type="revolute",
+                                  axis_cam=(1.0, 0.0, 0.0), origin_cam=(0.5, 0.0, 2.0))
+    axis, origin = prediction_to_world(pred, f)
+    np.testing.assert_allclose(axis, [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(origin, [1, 2.5, 2.5], atol=1e-12)
+    only_px = pred.model_copy(update={"origin_cam": None, "origin_px": (2.0, 2.0)})
+    assert prediction_to_world(only_px, f)[1] is None
