@@ -1,0 +1,141 @@
+"""Cavity depth on a box cabinet, both dedup stages, carving, motion limits, whole-scene assembly."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from react3d_core.articulation.limits import revolute_limit, set_limits
+from react3d_core.articulation.types import ArticulatedPart
+from react3d_core.assembly import _Geometry, carve_background
+from react3d_core.cavity import PartFrame, base_mesh, d_hit, d_mesh, estimate_cavity
+from react3d_core.config import CavityConfig, DedupConfig, LimitConfig
+from react3d_core.data.parts import OBB, Articulation
+from react3d_core.dedup import dedup_indices, overlap_matrix
+from react3d_core.synthetic.builder import MeshBuilder
+
+
+def cabinet_mesh(depth: float = 0.5):  # noqa: ANN201
+    """Open-front carcass (front plane y = 0, back board inner face at y = depth) and a door slab in front."""
+    m = MeshBuilder(edge=0.05)
+    t = 0.018
+    m.add_box([0, 0, 0], [t, depth + t, 0.8], (200, 200, 200))
+    m.add_box([0.6 - t, 0, 0], [0.6, depth + t, 0.8], (200, 200, 200))
+    m.add_box([t, 0, 0], [0.6 - t, depth, t], (200, 200, 200))
+    m.add_box([t, 0, 0.8 - t], [0.6 - t, depth, 0.8], (200, 200, 200))
+    m.add_box([t, depth, 0], [0.6 - t, depth + t, 0.8], (200, 200, 200))
+    m.add_box([0.002, -0.02, 0.002], [0.598, -0.002, 0.798], (150, 90, 60), key="door")
+    mesh, keys, ids = m.build()
+    return mesh, np.flatnonzero(keys == ids["door"])
+
+
+def door_frame() -> PartFrame:
+    return PartFrame(center=np.array([0.3, -0.011, 0.4]), u=np.array([0.0, 0.0, 1.0]), v=np.array([1.0, 0.0, 0.0]),
+                     n=np.array([0.0, 1.0, 0.0]), su=0.796, sv=0.596, thickness=0.018)
+
+
+def test_cavity_depth_of_a_box_cabinet() -> None:
+    mesh, _ = cabinet_mesh(0.5)
+    geo = _Geometry(mesh)
+    pf = door_frame()
+    # back face of the slab at y = -0.002; inner face of the back board at y = 0.5
+    assert d_hit(pf, geo.cast, CavityConfig()) == pytest.approx(0.502, abs=1e-4)
+    assert d_mesh(pf, mesh.bounds()) == pytest.approx(0.518 + 0.002, abs=1e-6)
+    d, src, _ = estimate_cavity(pf, geo.cast, mesh.bounds(), None, None, CavityConfig())
+    assert src == "hit" and d == pytest.approx(0.502, abs=1e-4)
+    base = base_mesh(pf, d, CavityConfig())
+    lo, hi = base.bounds()
+    assert lo[1] == pytest.approx(-0.002 + 0.002, abs=1e-9) and hi[1] == pytest.approx(-0.002 + 0.002 + d, abs=1e-9)
+    # every base face points away from its box: a closed, double-walled box (walls have thickness)
+    assert base.n_faces == 5 * 12
+
+
+def test_dedup_stage1_keeps_the_larger() -> None:
+    a = np.arange(100)
+    b = np.arange(10, 100)       # IoU 0.9 with a
+    c = np.arange(200, 260)
+    inter, size = overlap_matrix([a, b, c])
+    assert inter[0, 1] == 90 and inter[0, 2] == 0 and list(size) == [100, 90, 60]
+    assert dedup_indices([a, b, c], DedupConfig()) == [0, 2]
+
+
+def test_dedup_stage2_removes_a_merged_part() -> None:
+    left, right = np.arange(0, 50), np.arange(50, 100)
+    merged = np.arange(0, 100)        # IoU 0.5 with each half: stage 1 keeps all (tau_dup = 0.5 needs >=)
+    keep = dedup_indices([merged, left, right], DedupConfig(tau_dup=0.6))
+    assert keep == [1, 2]              # the union of the halves covers the merged part with IoU 1.0
+    # a single half does not cover it (IoU 0.5 < 0.8): nothing removed in stage 2
+    assert dedup_indices([merged, left], DedupConfig(tau_dup=0.6)) == [0, 1]
+
+
+def test_dedup_is_bounded_on_many_overlapping_candidates() -> None:
+    import time
+
+    rng = np.random.default_rng(0)
+    sets = [np.arange(s, s + int(rng.integers(50, 400))) for s in rng.integers(0, 5000, 200)]
+    t0 = time.perf_counter()
+    keep = dedup_indices(sets, DedupConfig())
+    assert time.perf_counter() - t0 < 10.0 and 0 < len(keep) < 200
+
+
+def test_carving_removes_background_inside_part_obb() -> None:
+    mesh, door_faces = cabinet_mesh()
+    obb = OBB(center=(0.3, -0.011, 0.4), axes=((0, 0, 1.0), (1.0, 0, 0), (0, 1.0, 0)), extents=(0.796, 0.596, 0.018))
+    part = ArticulatedPart(candidate_id=0, label="door", score=1.0, face_ids=door_faces,
+                           vertex_ids=np.unique(mesh.faces[door_faces]), initial=Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(0, 0, 0)),
+                           articulation=Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(0, 0, 0)),
+                           obb=obb, front_normal=np.array([0, 1.0, 0]), thickness=0.018, flat=True)
+    keep = carve_background(mesh, [part], 0.005)
+    assert not np.isin(door_faces, keep).any()
+    inside = obb.contains(mesh.vertices, 0.005)
+    assert not inside[mesh.faces[keep]].any()
+    # carcass faces well behind the door survive
+    assert len(keep) > 0.5 * (mesh.n_faces - len(door_faces))
+
+
+def test_revolute_limit_stops_at_a_wall() -> None:
+    """A door hinged 10 cm from a side wall (x = -0.1): opening towards -y swings it into the wall."""
+    m = MeshBuilder(edge=0.05)
+    m.add_box([-0.2, -1.0, 0], [-0.1, 0.5, 1.0], (200, 200, 200))  # wall plane x = -0.1
+    wall, _, _ = m.build()
+    geo = _Geometry(wall)
+    own = np.zeros(wall.n_faces, bool)
+    door = np.stack(np.meshgrid(np.linspace(0.02, 0.6, 30), [-0.01], np.linspace(0.1, 0.7, 10)), -1).reshape(-1, 3)
+    a = Articulation(joint_type="revolute", axis=(0, 0, -1), origin=(0.0, -0.01, 0.4))
+    cfg = LimitConfig(revolute_max_deg=180, revolute_step_deg=1.0)
+    q, src = revolute_limit(a, door, geo.distance_excluding(own), cfg)
+    # the free edge (r = 0.6) reaches the wall plane x = -0.1 + clearance when 0.6 cos(q) = -0.09
+    expect = np.pi - np.arccos(0.09 / 0.6)
+    assert src == "sweep" and q == pytest.approx(expect, abs=np.radians(2.5))
+    # the axis sign is fixed so that q > 0 opens out of the cavity (+y is into the cavity)
+    flipped = set_limits(a.model_copy(update={"axis": (0, 0, 1)}), door, np.array([0, 1.0, 0]), None, None, cfg)
+    np.testing.assert_allclose(flipped.axis, [0, 0, -1]) and flipped.limit_source == "cap"
+    drawer = set_limits(Articulation(joint_type="prismatic", axis=(0, 1, 0), origin=(0, 0, 0)), door,
+                        np.array([0, 1.0, 0]), 0.5, None, cfg)
+    np.testing.assert_allclose(drawer.axis, [0, -1, 0])
+    assert drawer.upper == pytest.approx(0.48) and drawer.limit_source == "cavity"
+
+
+@pytest.mark.slow
+def test_synthetic_scene_cavities_limits_no_interpenetration(synthetic_scene, tmp_path) -> None:  # noqa: ANN001
+    from flows.convert_scene import convert_scene
+    from react3d_core.data.mesh import load_mesh
+    from react3d_core.data.parts import InteractiveScene
+
+    root = synthetic_scene(seed=4, n_frames=40, kind="kitchen")
+    manifest = convert_scene(str(root), str(tmp_path / "o"), {"perception": {"backend": "oracle"}, "frames": {"stride": 1},
+                                                             "export": {"formats": ["urdf"]}})
+    m = InteractiveScene.load(manifest)
+    meta = json.loads((root / "synth_meta.json").read_text())
+    depths = np.array([p["interior_depth"] for p in meta["parts"]])
+    good = 0
+    for o in m.objects:
+        good += np.min(np.abs(depths - o.cavity_depth)) < 0.03
+        if o.articulation.joint_type == "prismatic":
+            assert o.articulation.upper <= o.cavity_depth
+    assert good >= 0.9 * len(m.objects)
+    bg = load_mesh(tmp_path / "o" / "meshes" / "background.ply")
+    for o in m.objects:
+        assert not o.obb.contains(bg.vertices, -0.005).any()  # no background vertex 5 mm deep inside a closed part
