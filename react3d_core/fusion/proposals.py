@@ -49,9 +49,26 @@ def _centroids(mesh: TriMesh) -> np.ndarray:
 
 
 def decimate(mesh: TriMesh, target_faces: int) -> tuple[TriMesh, np.ndarray]:
-    """Quadric decimation (Open3D) to ``target_faces``; scan faces map to the nearest decimated centroid."""
-    m = mesh.to_open3d().simplify_quadric_decimation(int(target_faces))
-    small = TriMesh(np.asarray(m.vertices), np.asarray(m.triangles))
+    """Vertex-clustering decimation (Open3D) to about ``target_faces``; scan faces map to the
+    decimated face with the nearest centroid.
+
+    Why clustering and not quadric error: on a 400k-face scan quadric decimation alone took 6 s,
+    clustering well under 1 s; fusion only needs nodes of roughly even size, not a faithful surface.
+    The voxel comes from the area: a grid of voxel v has about 2 A / v^2 triangles.
+    """
+    import open3d as o3d
+
+    tri = mesh.vertices[mesh.faces]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+    voxel = float(np.sqrt(2.0 * area / max(1, target_faces)))
+    m = mesh.to_open3d()
+    for _ in range(3):
+        small = m.simplify_vertex_clustering(voxel, o3d.geometry.SimplificationContraction.Average)
+        n = len(small.triangles)
+        if 0.7 * target_faces <= n <= 1.2 * target_faces:
+            break
+        voxel *= float(np.sqrt(n / target_faces))
+    small = TriMesh(np.asarray(small.vertices), np.asarray(small.triangles))
     _, fmap = cKDTree(_centroids(small)).query(_centroids(mesh), workers=-1)
     return small, fmap.astype(np.int64)
 

@@ -86,7 +86,7 @@ def candidates_from_proposals(
     """Top-k views, re-segmentation in the best view and clipping for each proposal."""
     from .reseg import resegment
 
-    tops = select_top_views([p.face_ids for p in proposals], buffers, dict(masks), mesh.n_faces, config)
+    tops = select_top_views([p.face_ids for p in proposals], buffers, masks, mesh.n_faces, config)
     by_id = {f.frame_id: f for f in scene.frames}
     out = []
     centroids = mesh.vertices[mesh.faces].mean(1)

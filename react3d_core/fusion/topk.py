@@ -7,7 +7,7 @@ All proposals of a frame are scored at once with one sparse product.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 from scipy import sparse
@@ -58,7 +58,7 @@ def frame_ious(face_ids: np.ndarray, masks: Sequence[np.ndarray], P: sparse.csr_
 def select_top_views(
     proposal_faces: Sequence[np.ndarray],
     buffers: dict[str, np.ndarray],
-    masks: dict[str, list[Mask2D]],
+    masks: Mapping[str, Sequence[Mask2D]],
     n_faces: int,
     config: PipelineConfig,
 ) -> list[list[TopView]]:

@@ -181,7 +181,8 @@ class OracleModel:
         return out
 
     def point_mask(self, frame: Frame, points: np.ndarray, labels: np.ndarray) -> Mask2D:
-        """The GT part under most positive points (a handle answers with its door), same boundary noise."""
+        """The GT part under most positive points (a handle answers with its door), with the same
+        boundary, handle-hole and whole-object noise as the masks (seeded by frame and points)."""
         img = self.part_image(frame)
         h, w = img.shape
         pts = np.asarray(points, float).reshape(-1, 2)
@@ -195,6 +196,10 @@ class OracleModel:
         vals, counts = np.unique(under, return_counts=True)
         pid = int(vals[np.argmax(counts)])
         m = self.part_region(img, pid, not self.noise.handle_holes) if pid in self.handles else img == pid
+        rng = np.random.default_rng([self.noise.seed, zlib.crc32(frame.frame_id.encode()), 2,
+                                     zlib.crc32(np.round(pos).astype(np.int64).tobytes())])
+        if pid in self.handles and self.parts[pid].base and rng.random() < self.noise.whole_object_rate:
+            m = m | np.isin(img, self.parts[pid].base)  # SAM often answers a door click with the cabinet
         m = self.boundary(m)
         label = "openable" if pid in self.handles else self.parts[pid].label
         return Mask2D(frame_id=frame.frame_id, label=label, score=1.0, mask=m, box=_box(m))
