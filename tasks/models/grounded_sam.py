@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import torch
@@ -29,13 +30,15 @@ _SPECIAL = {"[cls]", "[sep]", "[pad]", "[unk]", "[mask]", "<s>", "</s>", "<pad>"
 
 
 def match_phrase(label: str, phrases: Sequence[str]) -> str:
-    """Map a decoded Grounding DINO label (sub-phrase tokens) to the prompt phrase sharing most words."""
+    """Map a decoded Grounding DINO label (sub-phrase tokens) to the prompt phrase sharing most words,
+    ties going to the phrase with fewest words the label lacks ('door' -> 'door', not 'cabinet door')."""
     words = set(label.lower().replace(".", " ").split()) - _SPECIAL
-    best, best_n = " ".join(w for w in label.lower().split() if w not in _SPECIAL) or "openable", 0
+    best, best_key = " ".join(w for w in label.lower().split() if w not in _SPECIAL) or "openable", (0, 0)
     for p in phrases:
-        n = len(words & set(p.lower().split()))
-        if n > best_n:
-            best, best_n = p, n
+        pw = set(p.lower().split())
+        key = (len(words & pw), -len(pw - words))
+        if key[0] > 0 and key > best_key:
+            best, best_key = p, key
     return best
 
 
@@ -61,9 +64,16 @@ def detect(det: Loaded, images: Sequence[np.ndarray], phrases: Sequence[str],
     with torch.inference_mode():
         out = det.model(**inputs)
     out.logits, out.pred_boxes = out.logits.float(), out.pred_boxes.float()
-    sizes = [im.shape[:2] for im in images]
-    res = det.processor.post_process_grounded_object_detection(
-        out, inputs["input_ids"], threshold=box_threshold, text_threshold=text_threshold, target_sizes=sizes
+    return detections_from_outputs(det.processor, out, inputs["input_ids"], [im.shape[:2] for im in images],
+                                   phrases, box_threshold, text_threshold)
+
+
+def detections_from_outputs(processor: Any, out: Any, input_ids: torch.Tensor, sizes: Sequence[tuple[int, int]],
+                            phrases: Sequence[str], box_threshold: float, text_threshold: float) -> list[Detection]:
+    """Grounding DINO outputs (normalised cxcywh boxes) -> pixel boxes of each image's original size,
+    clipped to the image, degenerate boxes dropped, labels mapped to the prompt phrases."""
+    res = processor.post_process_grounded_object_detection(
+        out, input_ids, threshold=box_threshold, text_threshold=text_threshold, target_sizes=[tuple(s) for s in sizes]
     )
     dets = []
     for r, (h, w) in zip(res, sizes):

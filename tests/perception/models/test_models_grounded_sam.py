@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import torch
 
-from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, detect, detector_prompt,
-                                       masks_to_original, match_phrase)
+from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, detect, detections_from_outputs,
+                                       detector_prompt, masks_to_original, match_phrase)
 from tasks.models.loaders import load_detector, load_sam
 
 SIZES = [(48, 64), (96, 128), (60, 80)]
@@ -22,7 +22,8 @@ def loaded(tiny_models):
 def test_detector_prompt_and_phrase_matching():
     assert detector_prompt(["Cabinet door", "door.", " "]) == "cabinet door. door."
     assert match_phrase("cabinet", ["door", "cabinet door"]) == "cabinet door"
-    assert match_phrase("[CLS] door [SEP]", ["oven door", "door"]) == "oven door"  # first phrase with most shared words
+    assert match_phrase("[CLS] door [SEP]", ["oven door", "door"]) == "door"  # exact beats superset
+    assert match_phrase("oven", ["oven door", "door"]) == "oven door"
     assert match_phrase("[UNK]", ["door"]) == "openable"
 
 
@@ -91,3 +92,24 @@ def test_point_segmenter_reuses_embedding(loaded, make_frame, make_image):
     assert m1.mask.shape == m2.mask.shape == (96, 128) and 0.0 <= m1.score
     with pytest.raises(ValueError):
         ps.segment_points(f, im, np.zeros((2, 2)), np.array([1]))
+
+
+def test_known_boxes_map_to_original_pixels(loaded):
+    """Hand-computed: on a 128x96 image, normalised cxcywh (0.5,0.5,0.5,0.5) -> (32,24,96,72) px;
+    (0.95,0.5,0.3,0.2) -> x 102.4..140.8 clipped to 128, y 38.4..57.6; a query with all logits -10
+    (score sigmoid(-10) < 0.3) is dropped. Token logits pick the phrase: 'cabinet door' vs 'door'."""
+    from transformers.models.grounding_dino.modeling_grounding_dino import GroundingDinoObjectDetectionOutput
+
+    det, _ = loaded
+    ids = det.processor(text=detector_prompt(["cabinet door", "door"]), return_tensors="pt")["input_ids"]
+    toks = det.processor.tokenizer.convert_ids_to_tokens(ids[0])
+    assert toks == ["[CLS]", "cabinet", "door", ".", "door", ".", "[SEP]"]
+    logits = torch.full((1, 3, ids.shape[1]), -10.0)
+    logits[0, 0, 1:3] = 10.0  # 'cabinet door'
+    logits[0, 1, 4] = 10.0  # 'door'
+    boxes = torch.tensor([[[0.5, 0.5, 0.5, 0.5], [0.95, 0.5, 0.3, 0.2], [0.5, 0.5, 0.1, 0.1]]])
+    out = GroundingDinoObjectDetectionOutput(logits=logits, pred_boxes=boxes)
+    d = detections_from_outputs(det.processor, out, ids, [(96, 128)], ["cabinet door", "door"], 0.3, 0.25)[0]
+    np.testing.assert_allclose(d.boxes, [[32, 24, 96, 72], [102.4, 38.4, 128, 57.6]], atol=1e-4)
+    assert d.labels == ["cabinet door", "door"]
+    np.testing.assert_allclose(d.scores, [1 / (1 + np.exp(-10))] * 2, rtol=1e-6)
