@@ -104,13 +104,23 @@ def masks_to_original(sam: Loaded, low_res: torch.Tensor, original_size: Sequenc
     return m[:, 0].numpy().astype(bool)
 
 
-def sam_box_masks(sam: Loaded, emb: torch.Tensor, inputs: dict, i: int, image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
+def to_sam_input(coords: np.ndarray, original_size: Sequence[int], reshaped_size: Sequence[int]) -> np.ndarray:
+    """Pixel x,y coordinates (…, 2k) of the original image -> SAM's resized input (what SamProcessor
+    does to prompts), so prompts need no second pass of image pre-processing."""
+    (h, w), (rh, rw) = original_size, reshaped_size
+    c = np.asarray(coords, float).copy()
+    c[..., 0::2] *= rw / w
+    c[..., 1::2] *= rh / h
+    return c
+
+
+def sam_box_masks(sam: Loaded, emb: torch.Tensor, inputs: dict, i: int, boxes: np.ndarray) -> np.ndarray:
     """Masks (N,H,W) of frame ``i`` of an embedded batch for its N boxes (original pixel coordinates)."""
-    prompt = sam.processor(images=[image], input_boxes=[boxes.tolist()], return_tensors="pt")
+    orig, resh = inputs["original_sizes"][i].tolist(), inputs["reshaped_input_sizes"][i].tolist()
+    box_t = torch.as_tensor(to_sam_input(boxes, orig, resh)[None], device=sam.device, dtype=sam.dtype)
     with torch.inference_mode():
-        out = sam.model(image_embeddings=emb[i : i + 1], input_boxes=prompt["input_boxes"].to(sam.device, sam.dtype),
-                        multimask_output=False)
-    return masks_to_original(sam, out.pred_masks, inputs["original_sizes"][i].tolist(), inputs["reshaped_input_sizes"][i].tolist())
+        out = sam.model(image_embeddings=emb[i : i + 1], input_boxes=box_t, multimask_output=False)
+    return masks_to_original(sam, out.pred_masks, orig, resh)
 
 
 def sam2_box_masks(sam: Loaded, image: np.ndarray, boxes: np.ndarray) -> np.ndarray:
@@ -152,7 +162,7 @@ class GroundedSamSegmenter:
                 if is_sam2(self.sam):
                     masks = sam2_box_masks(self.sam, image, d.boxes)
                 else:
-                    masks = sam_box_masks(self.sam, emb, inputs, want.index(i), image, d.boxes)
+                    masks = sam_box_masks(self.sam, emb, inputs, want.index(i), d.boxes)
                 out.append([
                     Mask2D(frame_id=f.frame_id, label=lab, score=float(sc), mask=m, box=tuple(float(x) for x in b))
                     for m, b, sc, lab in zip(masks, d.boxes, d.scores, d.labels) if m.any()
@@ -182,23 +192,25 @@ class SamPointSegmenter:
         labels = np.asarray(labels, int).reshape(-1)
         if len(points) == 0 or len(points) != len(labels):
             raise ValueError(f"need N>0 points with N labels, got {len(points)} points and {len(labels)} labels")
-        prompt = self.sam.processor(images=[image], input_points=[[points.tolist()]], input_labels=[[labels.tolist()]],
-                                    return_tensors="pt")
-        feed = {"input_points": prompt["input_points"].to(self.sam.device, self.sam.dtype),
-                "input_labels": prompt["input_labels"].to(self.sam.device)}
         with torch.inference_mode():
             if is_sam2(self.sam):
-                out = self.sam.model(pixel_values=prompt["pixel_values"].to(self.sam.device, self.sam.dtype), **feed,
-                                     multimask_output=True)
+                prompt = self.sam.processor(images=[image], input_points=[[points.tolist()]], input_labels=[[labels.tolist()]],
+                                            return_tensors="pt")
+                out = self.sam.model(pixel_values=prompt["pixel_values"].to(self.sam.device, self.sam.dtype),
+                                     input_points=prompt["input_points"].to(self.sam.device, self.sam.dtype),
+                                     input_labels=prompt["input_labels"].to(self.sam.device), multimask_output=True)
             else:
-                emb, _ = self._embed(frame, image)
-                out = self.sam.model(image_embeddings=emb, **feed, multimask_output=True)
+                emb, inputs = self._embed(frame, image)
+                orig, resh = inputs["original_sizes"][0].tolist(), inputs["reshaped_input_sizes"][0].tolist()
+                pts = torch.as_tensor(to_sam_input(points, orig, resh)[None, None], device=self.sam.device, dtype=self.sam.dtype)
+                lab = torch.as_tensor(labels[None, None], device=self.sam.device)
+                out = self.sam.model(image_embeddings=emb, input_points=pts, input_labels=lab, multimask_output=True)
         best = int(out.iou_scores[0, 0].float().argmax())
         low = out.pred_masks[:, :, best : best + 1]
         if is_sam2(self.sam):
             mask = self.sam.processor.post_process_masks(low.float().cpu(), prompt["original_sizes"])[0][0, 0].numpy()
         else:
-            mask = masks_to_original(self.sam, low, prompt["original_sizes"][0].tolist(), prompt["reshaped_input_sizes"][0].tolist())[0]
+            mask = masks_to_original(self.sam, low, orig, resh)[0]
         ys, xs = np.nonzero(mask)
         box = (float(xs.min()), float(ys.min()), float(xs.max() + 1), float(ys.max() + 1)) if len(xs) else None
         return Mask2D(frame_id=frame.frame_id, label="openable", score=float(out.iou_scores[0, 0, best]), mask=mask.astype(bool), box=box)

@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, detect, detections_from_outputs,
-                                       detector_prompt, masks_to_original, match_phrase)
+                                       detector_prompt, masks_to_original, match_phrase, to_sam_input)
 from tasks.models.loaders import load_detector, load_sam
 
 SIZES = [(48, 64), (96, 128), (60, 80)]
@@ -79,6 +79,11 @@ def test_box_prompt_is_rescaled_like_the_image(loaded, make_frame, make_image):
     _, sam = loaded
     p = sam.processor(images=[make_image(96, 128, 0)], input_boxes=[[[20, 10, 100, 60]]], return_tensors="pt")
     np.testing.assert_allclose(p["input_boxes"][0, 0].numpy(), [10, 5, 50, 30])
+    ours = to_sam_input(np.array([[20, 10, 100, 60]]), (96, 128), p["reshaped_input_sizes"][0].tolist())
+    np.testing.assert_allclose(ours, [[10, 5, 50, 30]])  # our prompt scaling == the processor's
+    pts = sam.processor(images=[make_image(60, 80, 0)], input_points=[[[70, 50], [3, 1]]], return_tensors="pt")
+    np.testing.assert_allclose(to_sam_input(np.array([[70, 50], [3, 1]]), (60, 80), pts["reshaped_input_sizes"][0].tolist()),
+                               pts["input_points"][0, 0].numpy(), atol=1e-6)
 
 
 def test_point_segmenter_reuses_embedding(loaded, make_frame, make_image):
