@@ -90,8 +90,12 @@ def candidates_from_proposals(
     by_id = {f.frame_id: f for f in scene.frames}
     out = []
     centroids = mesh.vertices[mesh.faces].mean(1)
-    for prop, tv in zip(proposals, tops):
-        if not tv:
+    claimed = np.zeros(mesh.n_faces, bool)
+    # best-seen proposals first; one mostly inside an earlier candidate would re-segment to it
+    order = sorted(range(len(proposals)), key=lambda i: (-(tops[i][0].iou if tops[i] else 0.0), -len(proposals[i].face_ids)))
+    for i in order:
+        prop, tv = proposals[i], tops[i]
+        if not tv or claimed[prop.face_ids].mean() > CONTAINED:
             continue
         frame = by_id[tv[0].frame_id]
         faces, _mask = resegment(frame, mesh, wfaces, centroids, prop.face_ids, tv, buffers, point_segmenter, rasterizer, config)
@@ -102,6 +106,7 @@ def candidates_from_proposals(
             kept = largest_component(mesh, wfaces, kept, config.fusion.attach_m)
         if not len(kept):
             continue
+        claimed[kept] = True
         out.append(
             PartCandidate(
                 candidate_id=len(out),
