@@ -68,6 +68,7 @@ def _object_payload(obj: InteractiveObject, root: Path, max_faces: int) -> dict[
             "limit_source": a.limit_source,
         },
         "obb": {"center": list(obj.obb.center), "axes": [list(x) for x in obj.obb.axes], "extents": list(obj.obb.extents)},
+        "front_normal": list(obj.front_normal),
         "cavity_depth": obj.cavity_depth,
         "cavity_depth_source": obj.cavity_depth_source,
         "top_views": obj.top_views,

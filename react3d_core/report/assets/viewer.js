@@ -131,6 +131,25 @@
   // ---------- camera ----------
   const lo = P.bounds[0], hi = P.bounds[1];
   const cam = { target: scl(add(lo, hi), 0.5), yaw: -2.2, pitch: 0.55, dist: 1.1 * Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]) };
+  if (P.objects.length) {
+    // start inside the room, in front of the objects: look along their mean front normal (into the cavities)
+    const cs = P.objects.map((o) => o.obb.center), n = P.objects.length;
+    const t = [0, 1, 2].map((k) => cs.reduce((s, c) => s + c[k], 0) / n);
+    let d = [0, 1].map((k) => P.objects.reduce((s, o) => s - (o.front_normal ? o.front_normal[k] : 0), 0));
+    const dl = Math.hypot(d[0], d[1]);
+    if (dl > 1e-6) {
+      d = [d[0] / dl, d[1] / dl];
+      const span = Math.max(...cs.map((c) => Math.hypot(c[0] - t[0], c[1] - t[1], c[2] - t[2])));
+      let room = Infinity;  // free distance from the objects to the scene bounds along d
+      for (let k = 0; k < 2; k++) {
+        if (d[k] > 1e-6) room = Math.min(room, (hi[k] - t[k]) / d[k]);
+        if (d[k] < -1e-6) room = Math.min(room, (lo[k] - t[k]) / d[k]);
+      }
+      const dist = Math.max(1.0, Math.min(2.2 * span + 1.5, room - 0.2));
+      cam.target = t; cam.dist = dist; cam.yaw = Math.atan2(d[1], d[0]);
+      cam.pitch = Math.max(0.1, Math.min(0.7, Math.asin(Math.max(-1, Math.min(1, (Math.min(hi[2] - 0.3, 1.8) - t[2]) / dist)))));
+    }
+  }
   const show = { background: true, cavities: true, axes: true, labels: true };
   let selected = null, dirty = false;
   function eye() {
