@@ -6,20 +6,56 @@ set later in assembly (``limits.set_limits``), once cavities and neighbours are 
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from ..config import PipelineConfig
 from ..data.frames import SceneInput
 from ..data.masks import ArticulationPrediction
 from ..data.mesh import TriMesh
-from ..data.parts import PartCandidate
+from ..data.parts import OBB, Articulation, PartCandidate
 from .obb import min_obb
 from .refine import is_flat, refine_prismatic, refine_revolute, slab_mid_and_thickness
 from .types import ArticulatedPart
 from .validate import best_prediction, lift_prediction
 
 STAGE_VERSION = "1"
-__all__ = ["STAGE_VERSION", "ArticulatedPart", "articulate_candidate", "min_obb"]
+__all__ = ["STAGE_VERSION", "ArticulatedPart", "PartFit", "articulate_candidate", "fit_part", "min_obb",
+           "refine_articulation"]
+
+
+@dataclass
+class PartFit:
+    """The part's box and front slab, everything refinement needs (shared by the stage and the ablation)."""
+
+    obb: OBB
+    front_normal: np.ndarray
+    mid_center: np.ndarray
+    thickness: float
+    flat: bool
+
+
+def fit_part(points: np.ndarray, camera: np.ndarray, plane_normal: np.ndarray | None, flat_ratio: float) -> PartFit:
+    """Min-area OBB; n_front = u1 x u2 oriented into the cavity: along the clipping plane's normal when the
+    segmentation gave one, else away from the camera that segmented the part."""
+    obb = min_obb(points)
+    n = obb.R[:, 2].copy()
+    if plane_normal is not None:
+        n *= 1.0 if np.dot(n, plane_normal) >= 0 else -1.0
+    elif np.dot(n, np.asarray(obb.center) - np.asarray(camera, float)) < 0:
+        n = -n
+    mid, thickness = slab_mid_and_thickness(points, np.asarray(obb.center), n)
+    return PartFit(obb, n, mid, thickness, is_flat(obb, flat_ratio))
+
+
+def refine_articulation(initial: Articulation, fit: PartFit, refine: bool = True) -> Articulation:
+    """The paper's refinement on flat parts; ``refine=False`` (ablation) or a non-flat part keeps the prediction."""
+    if not (refine and fit.flat):
+        return initial
+    if initial.joint_type == "prismatic":
+        return refine_prismatic(initial, fit.front_normal)
+    return refine_revolute(initial, fit.obb, fit.mid_center)
 
 
 def _frame_depth_rgb(scene: SceneInput, frame_id: str, rasterizer) -> np.ndarray | None:  # noqa: ANN001
@@ -50,19 +86,11 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
     depth = _frame_depth_rgb(scene, view, rasterizer) if pred.origin_cam is None else None
     initial = lift_prediction(pred, frame, depth)
     pts = mesh.vertices[np.asarray(candidate.vertex_ids, np.int64)]
-    obb = min_obb(pts)
-    n = obb.R[:, 2].copy()
     seg_id = candidate.seg_frame_id or view
     cam = next((f.c2w[:3, 3] for f in scene.frames if f.frame_id == seg_id), frame.c2w[:3, 3])
-    if candidate.plane_normal is not None:
-        n *= 1.0 if np.dot(n, candidate.plane_normal) >= 0 else -1.0
-    elif np.dot(n, np.asarray(obb.center) - cam) < 0:  # into the cavity = away from the camera
-        n = -n
-    mid, thickness = slab_mid_and_thickness(pts, np.asarray(obb.center), n)
-    flat = is_flat(obb, config.articulation.flat_ratio)
-    art = initial
-    if config.articulation.refine and flat:
-        art = refine_prismatic(initial, n) if initial.joint_type == "prismatic" else refine_revolute(initial, obb, mid)
+    fit = fit_part(pts, cam, candidate.plane_normal, config.articulation.flat_ratio)
+    obb, n, thickness, flat = fit.obb, fit.front_normal, fit.thickness, fit.flat
+    art = refine_articulation(initial, fit, config.articulation.refine)
     return ArticulatedPart(
         candidate_id=candidate.candidate_id, label=candidate.label, score=float(candidate.score * pred.score),
         face_ids=np.asarray(candidate.face_ids, np.int64), vertex_ids=np.asarray(candidate.vertex_ids, np.int64),
