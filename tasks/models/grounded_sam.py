@@ -29,6 +29,19 @@ def detector_prompt(phrases: Sequence[str]) -> str:
 _SPECIAL = {"[cls]", "[sep]", "[pad]", "[unk]", "[mask]", "<s>", "</s>", "<pad>", "<unk>"}
 
 
+def phrase_groups(phrases: Sequence[str], tokenizer: Any, max_tokens: int) -> list[list[str]]:
+    """Split phrases into prompts that fit Grounding DINO's text length (256 tokens for the released
+    models); longer prompts would be truncated and their last phrases never detected."""
+    groups: list[list[str]] = [[]]
+    for p in phrases:
+        trial = groups[-1] + [p]
+        if groups[-1] and len(tokenizer(detector_prompt(trial))["input_ids"]) > max_tokens:
+            groups.append([p])
+        else:
+            groups[-1] = trial
+    return [g for g in groups if g]
+
+
 def match_phrase(label: str, phrases: Sequence[str]) -> str:
     """Map a decoded Grounding DINO label (sub-phrase tokens) to the prompt phrase sharing most words,
     ties going to the phrase with fewest words the label lacks ('door' -> 'door', not 'cabinet door')."""
@@ -141,6 +154,12 @@ class GroundedSamSegmenter:
         self.detector, self.sam = detector, sam
         self.box_threshold, self.text_threshold, self.batch_size = box_threshold, text_threshold, batch_size
 
+    def groups(self, phrases: Sequence[str]) -> list[list[str]]:
+        """Phrases per detector prompt (one prompt unless they exceed the model's text length)."""
+        tok = getattr(self.detector.processor, "tokenizer", None)
+        max_len = int(getattr(self.detector.model.config, "max_text_len", 256))
+        return phrase_groups(phrases, tok, max_len) if tok is not None else [list(phrases)]
+
     def segment(self, frames: Sequence[Frame], images: Sequence[np.ndarray], phrases: Sequence[str]) -> list[list[Mask2D]]:
         if len(frames) != len(images):
             raise ValueError(f"{len(frames)} frames but {len(images)} images")
@@ -150,7 +169,10 @@ class GroundedSamSegmenter:
         out: list[list[Mask2D]] = []
         for s in range(0, len(frames), self.batch_size):
             fr, im = list(frames[s : s + self.batch_size]), list(images[s : s + self.batch_size])
-            dets = detect(self.detector, im, phrases, self.box_threshold, self.text_threshold)
+            dets = [Detection(np.zeros((0, 4)), np.zeros(0), []) for _ in im]
+            for group in self.groups(phrases):
+                for d, g in zip(dets, detect(self.detector, im, group, self.box_threshold, self.text_threshold)):
+                    d.boxes, d.scores, d.labels = np.concatenate([d.boxes, g.boxes]), np.concatenate([d.scores, g.scores]), d.labels + g.labels
             want = [i for i, d in enumerate(dets) if len(d.boxes)]
             emb = inputs = None
             if want and not is_sam2(self.sam):

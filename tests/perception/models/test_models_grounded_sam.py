@@ -7,7 +7,8 @@ import pytest
 import torch
 
 from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, detect, detections_from_outputs,
-                                       detector_prompt, masks_to_original, match_phrase, to_sam_input)
+                                       detector_prompt, masks_to_original, match_phrase, phrase_groups,
+                                       to_sam_input)
 from tasks.models.loaders import load_detector, load_sam
 
 SIZES = [(48, 64), (96, 128), (60, 80)]
@@ -118,3 +119,19 @@ def test_known_boxes_map_to_original_pixels(loaded):
     np.testing.assert_allclose(d.boxes, [[32, 24, 96, 72], [102.4, 38.4, 128, 57.6]], atol=1e-4)
     assert d.labels == ["cabinet door", "door"]
     np.testing.assert_allclose(d.scores, [1 / (1 + np.exp(-10))] * 2, rtol=1e-6)
+
+
+def test_long_prompts_are_split_to_fit_the_text_length(loaded, make_frame, make_image):
+    """'cabinet door.' is 3 tokens; with [CLS]/[SEP] a prompt of k such phrases is 3k+2 tokens, so at
+    most 3 fit in 11 tokens: 7 phrases -> groups of 3, 3, 1. The tiny model's limit is 32 tokens."""
+    det, sam = loaded
+    tok = det.processor.tokenizer
+    phrases = ["cabinet door"] * 7
+    assert [len(g) for g in phrase_groups(phrases, tok, 11)] == [3, 3, 1]
+    assert phrase_groups(["door"], tok, 11) == [["door"]]
+    seg = GroundedSamSegmenter(det, sam, 0.0, 0.0, batch_size=2)
+    many = ["cabinet door", "drawer door", "oven door", "wardrobe door", "door", "table door", "chair door",
+            "floor door", "cabinet drawer", "oven drawer", "wardrobe drawer"]  # 33+ tokens > 32
+    assert len(seg.groups(many)) == 2
+    out = seg.segment([make_frame("a", 60, 80)], [make_image(60, 80, 0)], many)
+    assert len(out[0]) > 20  # 20 queries per prompt, two prompts
