@@ -24,10 +24,10 @@ def min_obb(points: np.ndarray) -> OBB:
         return OBB(center=tuple(c0), axes=((1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0)), extents=(0.0, 0.0, 0.0))
     _, _, vt = np.linalg.svd(q, full_matrices=False)
     best = _box_for_normal(q, vt[2], vt[0])
-    hull = _hull_normals(q)
-    if len(hull):
-        hv = q[np.unique(_hull_vertices(q))]
-        for n in hull:
+    h = _hull(q)
+    if h is not None:
+        hv = q[h.vertices]
+        for n in _hull_normals(q, h):
             cand = _box_for_normal(hv, n, None)
             if cand[2] < best[2] * (1 - 1e-6):
                 best = cand
@@ -71,16 +71,15 @@ def _hull(q: np.ndarray):  # noqa: ANN202
         return None
 
 
-def _hull_normals(q: np.ndarray) -> np.ndarray:
-    """Distinct facet normals of the convex hull (empty for a flat or degenerate cloud)."""
-    h = _hull(q)
-    if h is None:
-        return np.zeros((0, 3))
+def _hull_normals(q: np.ndarray, h, max_normals: int = 48) -> np.ndarray:  # noqa: ANN001
+    """Distinct normals of the convex hull's (``h``) largest facets.
+
+    Bounded so a noisy part with a hull of thousands of facets stays cheap; the facets that decide a
+    slab's box (its front and back, the sides) are the large ones."""
     n = h.equations[:, :3]
     n = n * np.where(n[:, [0]] < 0, -1.0, 1.0)  # n and -n give the same box
-    return np.unique(np.round(n, 6), axis=0)
-
-
-def _hull_vertices(q: np.ndarray) -> np.ndarray:
-    h = _hull(q)
-    return np.arange(len(q)) if h is None else h.vertices
+    t = q[h.simplices]
+    area = np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+    key, inv = np.unique(np.round(n, 3), axis=0, return_inverse=True)
+    total = np.bincount(inv.ravel(), weights=area, minlength=len(key))
+    return key[np.argsort(-total, kind="stable")[:max_normals]]

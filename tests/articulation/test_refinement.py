@@ -37,6 +37,19 @@ def test_obb_of_thin_slab() -> None:
     assert min_obb(np.zeros((1, 3))).extents == (0.0, 0.0, 0.0)
 
 
+def test_obb_of_door_with_handle_is_not_tilted() -> None:
+    """A bar handle (4 cm proud, near one edge) tilts the PCA normal; the minimal-volume box must not."""
+    door = slab(n=1000)
+    zs = np.linspace(0.3, 0.5, 40)
+    handle = np.concatenate([np.stack([np.full(40, 0.55), np.full(40, -0.04), zs], 1),
+                             np.stack([np.full(40, 0.57), np.full(40, -0.04), zs], 1)])
+    pca_n = np.linalg.svd(np.concatenate([door, handle]) - np.concatenate([door, handle]).mean(0))[2][2]
+    assert np.degrees(np.arccos(abs(pca_n[1]))) > 0.5  # PCA alone is off by more than half a degree
+    obb = min_obb(np.concatenate([door, handle]))
+    assert abs(obb.R[:, 2][1]) == pytest.approx(1.0, abs=1e-6)  # box normal = y exactly
+    np.testing.assert_allclose(obb.extents, [0.8, 0.6, 0.06], atol=2e-3)  # thickness 0.02 + 0.04 handle
+
+
 def _door_obb() -> OBB:
     # u1 = z (0.8 tall), u2 = x (0.6 wide), u3 = y (0.02 thick); centre of the slab
     return OBB(center=(0.3, 0.01, 0.4), axes=((0, 0, 1.0), (1.0, 0, 0), (0, 1.0, 0)), extents=(0.8, 0.6, 0.02))
