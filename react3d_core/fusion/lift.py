@@ -88,3 +88,56 @@ def lift_masks(raster: RasterResult, masks: Sequence[Mask2D], config: PipelineCo
             out.face_sets.append(f.astype(np.int64))
             out.mask_index.append(i)
     return out
+
+
+@dataclass
+class ViewStats:
+    """What top-k needs of one frame, without its pixels: the face histogram of the whole buffer and,
+    per usable mask (hole-filled, not eroded), the faces under it with pixel counts and its area."""
+
+    frame_id: str
+    faces: np.ndarray
+    counts: np.ndarray
+    mask_index: list[int] = field(default_factory=list)
+    mask_faces: list[np.ndarray] = field(default_factory=list)
+    mask_counts: list[np.ndarray] = field(default_factory=list)
+    mask_area: list[int] = field(default_factory=list)
+    at_border: list[bool] = field(default_factory=list)
+
+
+def _histogram(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    f, c = np.unique(ids, return_counts=True)
+    keep = f >= 0
+    return f[keep].astype(np.int64), c[keep].astype(np.int64)
+
+
+def lift_with_stats(raster: RasterResult, masks: Sequence[Mask2D], config: PipelineConfig) -> tuple[FrameLift, ViewStats]:
+    """``lift_masks`` plus the frame's :class:`ViewStats`, sharing the hole filling."""
+    ids = raster.face_ids
+    shape = ids.shape
+    w = shape[1]
+    lift = FrameLift(raster.frame_id)
+    f_all, c_all = _histogram(ids)
+    stats = ViewStats(raster.frame_id, f_all, c_all)
+    b = scaled_px(config.topk.border_px, masks[0].mask.shape[1]) if masks else 0
+    e = scaled_px(config.fusion.erode_px, w)
+    for i, mk in enumerate(masks):
+        full = mk.mask
+        if not full.any():
+            continue
+        filled_m = filled(full, shape, config)
+        f = ids[erode(filled_m, e)]
+        f = np.unique(f[f >= 0])
+        if len(f):
+            lift.face_sets.append(f.astype(np.int64))
+            lift.mask_index.append(i)
+        area = int(full.sum())
+        if area < config.topk.min_mask_px * (full.shape[1] / REF_WIDTH) ** 2:
+            continue
+        mf, mc = _histogram(ids[filled_m])
+        stats.mask_index.append(i)
+        stats.mask_faces.append(mf)
+        stats.mask_counts.append(mc)
+        stats.mask_area.append(int(filled_m.sum()))
+        stats.at_border.append(b > 0 and bool(full[:b].any() or full[-b:].any() or full[:, :b].any() or full[:, -b:].any()))
+    return lift, stats

@@ -17,9 +17,9 @@ from ..raster import Rasterizer
 from ..raster.rasterizer import RasterResult
 from .clip import clip_part
 from .connectivity import largest_component
-from .lift import FrameLift, lift_masks
+from .lift import FrameLift, ViewStats, lift_with_stats
 from .proposals import FusionMesh, Proposal, fuse_proposals, prepare_fusion_mesh
-from .topk import select_top_views
+from .topk import top_views_from_stats
 
 DUPLICATE_IOU = 0.5
 CONTAINED = 0.8
@@ -36,17 +36,20 @@ def render_work(rasterizer: Rasterizer, frame: Frame, config: PipelineConfig) ->
 
 def lift_frames(
     scene: SceneInput, masks: Mapping[str, Sequence[Mask2D]], rasterizer: Rasterizer, config: PipelineConfig
-) -> tuple[list[FrameLift], dict[str, np.ndarray]]:
-    """Render each frame with masks once (working width) and lift its masks; keeps the buffers for top-k."""
-    lifts, buffers = [], {}
+) -> tuple[list[FrameLift], dict[str, np.ndarray], list[ViewStats]]:
+    """Render each frame with masks once (working width), lift its masks and collect its top-k
+    statistics; keeps the buffers for re-segmentation prompts."""
+    lifts, buffers, stats = [], {}, []
     for f in scene.frames:
         ms = masks.get(f.frame_id)
         if not ms:
             continue
         r = render_work(rasterizer, f, config)
         buffers[f.frame_id] = r.face_ids
-        lifts.append(lift_masks(r, ms, config))
-    return lifts, buffers
+        lift, st = lift_with_stats(r, list(ms), config)
+        lifts.append(lift)
+        stats.append(st)
+    return lifts, buffers, stats
 
 
 def _vertex_ids(mesh: TriMesh, faces: np.ndarray) -> np.ndarray:
@@ -77,6 +80,7 @@ def candidates_from_proposals(
     mesh: TriMesh,
     proposals: Sequence[Proposal],
     buffers: dict[str, np.ndarray],
+    stats: Sequence[ViewStats],
     masks: Mapping[str, Sequence[Mask2D]],
     point_segmenter: PointPromptSegmenter,
     rasterizer: Rasterizer,
@@ -86,7 +90,7 @@ def candidates_from_proposals(
     """Top-k views, re-segmentation in the best view and clipping for each proposal."""
     from .reseg import resegment
 
-    tops = select_top_views([p.face_ids for p in proposals], buffers, masks, mesh.n_faces, config)
+    tops = top_views_from_stats([p.face_ids for p in proposals], stats, masks, mesh.n_faces, config)
     by_id = {f.frame_id: f for f in scene.frames}
     out = []
     centroids = mesh.vertices[mesh.faces].mean(1)
@@ -143,7 +147,7 @@ def segment_parts(
     rasterizer = rasterizer or Rasterizer(mesh)
     fm = fusion_mesh or prepare_fusion_mesh(mesh, config)
     t1 = time.perf_counter()
-    lifts, buffers = lift_frames(scene, masks, rasterizer, config)
+    lifts, buffers, stats = lift_frames(scene, masks, rasterizer, config)
     t2 = time.perf_counter()
     proposals = fuse_proposals(lifts, mesh, config, fm)
     t3 = time.perf_counter()
@@ -151,7 +155,7 @@ def segment_parts(
 
     wfaces = fm.wfaces if fm.mesh is mesh else welded_faces(mesh, config.fusion.weld_m)
     t4 = time.perf_counter()
-    cands = candidates_from_proposals(scene, mesh, proposals, buffers, masks, point_segmenter, rasterizer, config, wfaces)
+    cands = candidates_from_proposals(scene, mesh, proposals, buffers, stats, masks, point_segmenter, rasterizer, config, wfaces)
     t5 = time.perf_counter()
     t.update(prepare=t1 - t0, weld_full=t4 - t3, lift=t2 - t1, fuse=t3 - t2, topk_reseg_clip=t5 - t4,
              n_proposals=float(len(proposals)), n_candidates=float(len(cands)))

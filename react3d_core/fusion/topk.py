@@ -15,7 +15,8 @@ from scipy import sparse
 from ..config import PipelineConfig
 from ..data.masks import Mask2D
 from ..data.parts import TopView
-from .lift import REF_WIDTH, filled, scaled_px
+from ..raster.rasterizer import RasterResult
+from .lift import REF_WIDTH, ViewStats, lift_with_stats, scaled_px
 
 
 def big_enough(mask: Mask2D, config: PipelineConfig) -> bool:
@@ -55,6 +56,60 @@ def frame_ious(face_ids: np.ndarray, masks: Sequence[np.ndarray], P: sparse.csr_
         return np.where(union > 0, inter / union, 0.0)
 
 
+def top_views_from_stats(
+    proposal_faces: Sequence[np.ndarray],
+    stats: Sequence[ViewStats],
+    masks: Mapping[str, Sequence[Mask2D]],
+    n_faces: int,
+    config: PipelineConfig,
+) -> list[list[TopView]]:
+    """For each proposal, its k best views (one mask per frame) with IoU > ``min_iou``, best first.
+
+    IoUs of all masks with all proposals come from two sparse products of face histograms:
+    intersection = mask histogram . proposal membership, silhouette = frame histogram . membership.
+    Masks touching the border are skipped; only for a proposal no other mask matches (a part the
+    capture always cuts off, e.g. low cabinets) are they used, so such parts are not lost.
+    """
+    n_p = len(proposal_faces)
+    out: list[list[TopView]] = [[] for _ in range(n_p)]
+    rows = [(si, j) for si, st in enumerate(stats) for j in range(len(st.mask_index))]
+    if not n_p or not rows:
+        return out
+    P = membership_matrix(proposal_faces, n_faces)[:n_faces]
+
+    def hist(face_lists: list[np.ndarray], count_lists: list[np.ndarray]) -> sparse.csr_matrix:
+        r = np.repeat(np.arange(len(face_lists)), [len(f) for f in face_lists])
+        return sparse.csr_matrix((np.concatenate(count_lists).astype(np.float64), (r, np.concatenate(face_lists))),
+                                 shape=(len(face_lists), n_faces))
+
+    Hf = hist([st.faces for st in stats], [st.counts for st in stats])
+    Hm = hist([stats[si].mask_faces[j] for si, j in rows], [stats[si].mask_counts[j] for si, j in rows])
+    sil = (Hf @ P).toarray()  # frames x props
+    inter = (Hm @ P).toarray()  # masks x props
+    frame_of = np.array([si for si, _ in rows])
+    area = np.array([stats[si].mask_area[j] for si, j in rows], float)
+    border = np.array([stats[si].at_border[j] for si, j in rows])
+    union = area[:, None] + sil[frame_of] - inter
+    with np.errstate(divide="ignore", invalid="ignore"):
+        iou = np.where(union > 0, inter / union, 0.0)
+    for p in range(n_p):
+        col = iou[:, p]
+        for sel in (~border, border):  # inner masks first; border masks only as a fallback
+            cand = np.nonzero(sel & (col > config.topk.min_iou))[0]
+            if not len(cand):
+                continue
+            best: dict[int, int] = {}
+            for r in cand[np.argsort(-col[cand], kind="stable")]:
+                best.setdefault(int(frame_of[r]), int(r))  # one mask per frame, its best
+            chosen = sorted(best.values(), key=lambda r: (-col[r], stats[frame_of[r]].frame_id))[: config.topk.k]
+            for r in chosen:
+                st = stats[frame_of[r]]
+                mk = masks[st.frame_id][st.mask_index[rows[r][1]]]
+                out[p].append(TopView(frame_id=st.frame_id, iou=float(col[r]), mask=mk))
+            break
+    return out
+
+
 def select_top_views(
     proposal_faces: Sequence[np.ndarray],
     buffers: dict[str, np.ndarray],
@@ -62,31 +117,10 @@ def select_top_views(
     n_faces: int,
     config: PipelineConfig,
 ) -> list[list[TopView]]:
-    """For each proposal, its k best views (one mask per frame) with IoU > ``min_iou``, best first.
-
-    Masks touching the border are skipped; only for a proposal no other mask matches (a part the
-    capture always cuts off, e.g. low cabinets) are they used, so such parts are not lost.
-    """
-    P = membership_matrix(proposal_faces, n_faces)
-    inner: list[list[TopView]] = [[] for _ in proposal_faces]
-    border: list[list[TopView]] = [[] for _ in proposal_faces]
+    """Top-k views from face-id buffers and masks (see :func:`top_views_from_stats`)."""
+    stats = []
     for fid, ids in buffers.items():
-        ms = [m for m in masks.get(fid, []) if big_enough(m, config)]
-        if not ms or not len(proposal_faces):
-            continue
-        prepared = [filled(m.mask, ids.shape, config) for m in ms]
-        at_border = np.array([touches_border(m, config) for m in ms])
-        iou = frame_ious(ids, prepared, P)
-        for group, sel in ((inner, ~at_border), (border, at_border)):
-            if not sel.any():
-                continue
-            sub = np.where(sel[:, None], iou, -1.0)
-            j = np.argmax(sub, 0)
-            top = sub[j, np.arange(sub.shape[1])]
-            for p in np.nonzero(top > config.topk.min_iou)[0]:
-                group[p].append(TopView(frame_id=fid, iou=float(top[p]), mask=ms[int(j[p])]))
-    out = []
-    for a, b in zip(inner, border):
-        views = a if a else b
-        out.append(sorted(views, key=lambda t: (-t.iou, t.frame_id))[: config.topk.k])
-    return out
+        ms = list(masks.get(fid, []))
+        if ms:
+            stats.append(lift_with_stats(RasterResult(fid, ids, np.zeros(ids.shape, np.float32)), ms, config)[1])
+    return top_views_from_stats(proposal_faces, stats, masks, n_faces, config)
