@@ -25,9 +25,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 import numpy as np  # noqa: E402
 
-from react3d_core.articulation import fit_part, refine_articulation  # noqa: E402
+from react3d_core.articulation import ArticulatedPart, fit_part, refine_articulation  # noqa: E402
 from react3d_core.config import PipelineConfig  # noqa: E402
-from react3d_core.data.mesh import load_mesh  # noqa: E402
+from react3d_core.data.frames import SceneInput  # noqa: E402
+from react3d_core.data.mesh import TriMesh, load_mesh  # noqa: E402
 from react3d_core.data.parts import Articulation  # noqa: E402
 from react3d_core.ground_truth.articulate3d import read_articulate3d  # noqa: E402
 from react3d_core.metrics.geometry import axis_error_deg, line_distance  # noqa: E402
@@ -54,18 +55,19 @@ def joint_errors(pred: Articulation, gt: Articulation) -> tuple[float, float | N
     return oe, line_distance(np.asarray(pred.origin), np.asarray(pred.axis), np.asarray(gt.origin), np.asarray(gt.axis))
 
 
-def _camera_for(centers: np.ndarray, dirs: np.ndarray, point: np.ndarray) -> np.ndarray:
-    """The nearest camera whose optical axis points at ``point`` (within 60 deg)."""
+def _camera_for(centers: np.ndarray, dirs: np.ndarray, point: np.ndarray) -> int:
+    """Index of the nearest camera whose optical axis points at ``point`` (within 60 deg)."""
     v = point - centers
     dist = np.linalg.norm(v, axis=1)
     facing = (v * dirs).sum(1) / np.maximum(dist, 1e-9) > 0.5
     idx = np.flatnonzero(facing) if facing.any() else np.arange(len(centers))
-    return centers[idx[np.argmin(dist[idx])]]
+    return int(idx[np.argmin(dist[idx])])
 
 
-def ablate_scene(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7.0, origin_noise_m: float = 0.2,
-                 config: PipelineConfig | None = None) -> list[dict]:
-    """One row per GT movable part: errors with and without refinement."""
+def oracle_parts(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7.0, origin_noise_m: float = 0.2,
+                 config: PipelineConfig | None = None, refine: bool = True) -> tuple[SceneInput, TriMesh, list[tuple[ArticulatedPart, Articulation]]]:
+    """Oracle segmentation of a synthetic scene: one ``ArticulatedPart`` per GT movable part (with its
+    handle), initial joint = noisy GT, refined by the stage's code; paired with the GT joint."""
     cfg = config or PipelineConfig()
     scene_dir = Path(scene_dir)
     scene = load_scene(scene_dir)
@@ -73,27 +75,40 @@ def ablate_scene(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7
     gt = read_articulate3d(scene_dir / "articulate3d")
     meta = json.loads((scene_dir / "synth_meta.json").read_text())
     handle_of = {p["part_id"]: p.get("handle_part_id") for p in meta["parts"]}
-    verts = {p.part_id: p.vert_indices for p in gt.parts}
+    by_id = {p.part_id: p for p in gt.parts}
     centers = np.array([f.c2w[:3, 3] for f in scene.frames])
     dirs = np.array([f.c2w[:3, 2] for f in scene.frames])
     rng = np.random.default_rng(seed)
-    rows = []
+    out = []
     for p in gt.parts:
         if p.articulation is None:
             continue
-        ids = p.vert_indices
-        h = handle_of.get(p.part_id)
-        if h is not None and h in verts:
-            ids = np.union1d(ids, verts[h])
-        pts = mesh.vertices[ids]
+        vids, fids = p.vert_indices, p.tri_indices
+        h = by_id.get(handle_of.get(p.part_id, -1))
+        if h is not None:
+            vids, fids = np.union1d(vids, h.vert_indices), np.union1d(fids, h.tri_indices)
+        pts = mesh.vertices[vids]
         cam = _camera_for(centers, dirs, pts.mean(0))
-        fit = fit_part(pts, cam, None, cfg.articulation.flat_ratio)
+        fit = fit_part(pts, centers[cam], None, cfg.articulation.flat_ratio)
         initial = perturb(p.articulation, rng, axis_noise_deg, origin_noise_m)
-        refined = refine_articulation(initial, fit, True)
-        oe0, md0 = joint_errors(initial, p.articulation)
-        oe1, md1 = joint_errors(refined, p.articulation)
-        rows.append({"scene": scene_dir.name, "part_id": p.part_id, "label": p.label, "type": p.articulation.joint_type,
-                     "flat": fit.flat, "oe_off": oe0, "md_off": md0, "oe_on": oe1, "md_on": md1})
+        art = refine_articulation(initial, fit, refine)
+        part = ArticulatedPart(candidate_id=p.part_id, label=p.label, score=1.0, face_ids=fids, vertex_ids=vids,
+                               initial=initial, articulation=art, obb=fit.obb, front_normal=fit.front_normal,
+                               thickness=fit.thickness, flat=fit.flat, seg_frame_id=scene.frames[cam].frame_id)
+        out.append((part, p.articulation))
+    return scene, mesh, out
+
+
+def ablate_scene(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7.0, origin_noise_m: float = 0.2,
+                 config: PipelineConfig | None = None) -> list[dict]:
+    """One row per GT movable part: errors with and without refinement (same noise draw)."""
+    _, _, parts = oracle_parts(scene_dir, seed, axis_noise_deg, origin_noise_m, config)
+    rows = []
+    for part, gt in parts:
+        oe0, md0 = joint_errors(part.initial, gt)
+        oe1, md1 = joint_errors(part.articulation, gt)
+        rows.append({"scene": Path(scene_dir).name, "part_id": part.candidate_id, "label": part.label,
+                     "type": gt.joint_type, "flat": part.flat, "oe_off": oe0, "md_off": md0, "oe_on": oe1, "md_on": md1})
     return rows
 
 
