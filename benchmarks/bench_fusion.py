@@ -6,9 +6,10 @@
 Generates (once, cached) a 300-frame kitchen with furniture triangles of 1.2 cm (> 300k faces),
 makes oracle masks (default realism) for every frame, then runs ``segment_parts`` on the first
 75 / 150 / 300 frames (evenly spread) in a fresh process each, and reports wall time per sub-stage,
-peak RSS of that process (sampled every 20 ms; it holds the masks bit-packed and unpacks them on
+process CPU seconds (user + sys: a shared, loaded machine inflates wall time, not CPU time), the
+1-minute load average, peak RSS of that process (sampled every 20 ms; it holds the masks bit-packed and unpacks them on
 access, as a store-backed mapping would), candidates and vertex-IoU recall/precision. A last row
-runs 300 frames without decimation (``decimate_faces=None``) to show whether decimation pays off.
+runs 75 frames without decimation (``decimate_faces=None``) to show whether decimation pays off.
 Mask generation is not part of the fusion time.
 """
 
@@ -126,15 +127,18 @@ def run_one(scene: str, cache: str, n: int, decimate: bool, out: mp.Queue) -> No
     th = threading.Thread(target=sample, daemon=True)
     th.start()
     timings: dict[str, float] = {}
+    cpu0 = proc.cpu_times()
     t = time.perf_counter()
     rast = Rasterizer(mesh)
     timings["bvh"] = time.perf_counter() - t
     cands = segment_parts(s, mesh, masks, perc.point_segmenter, cfg, rasterizer=rast, timings=timings)
     total = time.perf_counter() - t
+    cpu1 = proc.cpu_times()
+    cpu = (cpu1.user - cpu0.user) + (cpu1.system - cpu0.system)
     stop.set()
     th.join()
     q = segmentation_quality(cands, read_articulate3d(s.gt_dir), seen)
-    out.put({"frames": len(s.frames), "faces": mesh.n_faces, "decimate": decimate, "total_s": total,
+    out.put({"frames": len(s.frames), "faces": mesh.n_faces, "decimate": decimate, "total_s": total, "cpu_s": cpu, "load_avg": os.getloadavg()[0],
              **{k: v for k, v in timings.items()}, "peak_rss_gb": peak[0] / 2**30, "rss_before_gb": base / 2**30,
              "recall": q.recall(0.5), "precision": q.precision(0.5), "eligible_parts": len(q.eligible)})
 
@@ -146,6 +150,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--edge", type=float, default=0.012, help="furniture triangle size (m) of the generated scene")
     p.add_argument("--frames", default="75,150,300", help="frame counts to fuse")
     p.add_argument("--no-decimate-row", action="store_true", help="skip the run without decimation")
+    p.add_argument("--no-decimate-frames", type=int, default=75, help="frames of the run without decimation")
     p.add_argument("--json", default=None)
     a = p.parse_args(argv)
 
@@ -155,7 +160,7 @@ def main(argv: list[str] | None = None) -> int:
     scene, cache = scene_and_masks(a.scene, a.n_frames, a.edge)
     runs = [(int(n), True) for n in a.frames.split(",")]
     if not a.no_decimate_row:
-        runs.append((max(n for n, _ in runs), False))
+        runs.append((a.no_decimate_frames, False))
     ctx = mp.get_context("spawn")
     rows = []
     for n, dec in runs:
@@ -165,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
         rows.append(q.get())
         pr.join()
         print(json.dumps(rows[-1]))
-    cols = ["frames", "faces", "decimate", "total_s", "bvh", "prepare", "lift", "fuse", "topk_reseg_clip",
+    cols = ["frames", "faces", "decimate", "total_s", "cpu_s", "load_avg", "bvh", "prepare", "lift", "fuse", "topk_reseg_clip",
             "n_proposals", "n_candidates", "peak_rss_gb", "recall", "precision"]
     t = Table(title=f"fusion on {scene.name} ({os.cpu_count()} cores)")
     for c in cols:

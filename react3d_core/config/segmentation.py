@@ -15,7 +15,7 @@ class FusionConfig(StageConfig):
     min_community_faces: int = Field(10, ge=1, description="Keep communities with more faces than this.")
     decimate_faces: int | None = Field(80000, description="Fuse on a mesh decimated to this many faces (None: full mesh).")
     seed: int = Field(0, description="Seed for pair sampling and Louvain.")
-    work_width: int | None = Field(480, ge=16, description="Render, lift and score views at this image width (None: the masks' own size).")
+    work_width: int | None = Field(320, ge=16, description="Render, lift and score views at this image width (None: the masks' own size).")
     weld_m: float = Field(0.005, ge=0, description="Vertices closer than this count as one for connectivity (scans may not be welded).")
     attach_m: float = Field(0.02, ge=0, description="Components this close to a part's largest component stay with it (handles on doors).")
 

@@ -12,7 +12,7 @@ import numpy as np
 from ..config import ClipConfig
 from ..data.mesh import TriMesh
 
-MAX_POINTS = 4000
+MAX_POINTS = 2000
 
 
 def face_geometry(mesh: TriMesh, face_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
