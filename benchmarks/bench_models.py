@@ -106,14 +106,18 @@ def bench_one(name: str, build: Callable[[], Any], run: Callable[..., Any], devi
         # reference with rebuild per call
         t_rb = sum(timed(lambda: run(build().to(device), 1, device, torch.float32), device) for _ in range(rebuild_calls))
         ours = build().to(device=device, dtype=dtype)
+        if device.type == "cuda":
+            torch.cuda.reset_peak_memory_stats(device)
         run(ours, batch, device, dtype)  # warm-up
         n_batches = max(1, n_images // batch)
         t_ours = sum(timed(lambda: run(ours, batch, device, dtype), device) for _ in range(n_batches))
         del ours
+    peak_gb = None
     if device.type == "cuda":
+        peak_gb = torch.cuda.max_memory_allocated(device) / 2**30
         torch.cuda.empty_cache()
     row = {"model": name, "ref_fp32_b1_img_s": n_images / t_fwd, "ref_rebuild_img_s": rebuild_calls / t_rb,
-           "ours_img_s": n_batches * batch / t_ours, "batch": batch, "dtype": str(dtype).replace("torch.", "")}
+           "ours_img_s": n_batches * batch / t_ours, "batch": batch, "dtype": str(dtype).replace("torch.", ""), "ours_peak_gpu_gb": peak_gb}
     row["speedup_vs_ref"] = row["ours_img_s"] / row["ref_fp32_b1_img_s"]
     return row
 
