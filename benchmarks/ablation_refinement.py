@@ -112,6 +112,22 @@ def ablate_scene(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7
     return rows
 
 
+def cavity_rows(scene_dir: str | Path, out_dir: str | Path, seed: int = 0, config: PipelineConfig | None = None) -> list[dict]:
+    """Assemble the oracle parts of a scene; per object: cavity depth vs the true interior depth
+    (synth_meta.json) and whether a drawer's travel stays inside its cavity."""
+    from react3d_core.assembly import assemble_scene
+
+    cfg = config or PipelineConfig()
+    scene, mesh, pairs = oracle_parts(scene_dir, seed, config=cfg)
+    m = assemble_scene(scene, mesh, [p for p, _ in pairs], cfg, out_dir)
+    meta = json.loads((Path(scene_dir) / "synth_meta.json").read_text())
+    depth_of = {p["label"]: p.get("interior_depth") for p in meta["parts"]}
+    return [{"scene": Path(scene_dir).name, "label": o.label, "type": o.articulation.joint_type,
+             "cavity": o.cavity_depth, "source": o.cavity_depth_source, "true": depth_of.get(o.label),
+             "err": abs(o.cavity_depth - depth_of[o.label]) if depth_of.get(o.label) is not None else None,
+             "upper": o.articulation.upper, "limit_source": o.articulation.limit_source} for o in m.objects]
+
+
 def summarize(rows: list[dict]) -> dict[str, float | int]:
     def mean(key: str) -> float:
         v = [r[key] for r in rows if r[key] is not None]
@@ -128,6 +144,7 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--frames", type=int, default=12)
     ap.add_argument("--work", default=None, help="where generated scenes go (default: a temp dir)")
     ap.add_argument("--json", default=None)
+    ap.add_argument("--no-cavity", action="store_true", help="skip assembling the scenes (cavity depth check)")
     args = ap.parse_args(argv)
     dirs = [Path(d) for d in args.scene_dir]
     work = Path(args.work or tempfile.mkdtemp(prefix="ablation_refinement_"))
@@ -149,6 +166,19 @@ def main(argv: list[str] | None = None) -> dict:
     print(f"{'refine on':14s}{s['oe_on_deg']:10.2f}{s['md_on_m']:10.3f}")
     for name, v in res["per_scene"].items():
         print(f"  {name}: on OE {v['oe_on_deg']:.2f} MD {v['md_on_m']:.3f} ({v['parts']} parts)")
+    if not args.no_cavity:
+        t1 = time.perf_counter()
+        cav = [r for i, d in enumerate(dirs) for r in cavity_rows(d, work / f"assembled_{d.name}", seed=i)]
+        errs = np.array([r["err"] for r in cav if r["err"] is not None])
+        drawers = [r for r in cav if r["type"] == "prismatic"]
+        res["cavity"] = {"objects": len(cav), "within_3cm": float((errs < 0.03).mean()) if len(errs) else float("nan"),
+                         "median_err_m": float(np.median(errs)) if len(errs) else float("nan"),
+                         "drawers": len(drawers), "drawer_limit_inside_cavity": all(r["upper"] <= r["cavity"] for r in drawers),
+                         "sources": {k: sum(r["source"] == k for r in cav) for k in sorted({r["source"] for r in cav})},
+                         "seconds": time.perf_counter() - t1, "rows": cav}
+        c = res["cavity"]
+        print(f"cavity depth within 3 cm: {c['within_3cm']:.1%} of {c['objects']} objects (median error {c['median_err_m']:.3f} m), "
+              f"drawer limits inside cavity: {c['drawer_limit_inside_cavity']} ({c['drawers']} drawers), sources {c['sources']}")
     if args.json:
         Path(args.json).write_text(json.dumps(res, indent=1))
     return res
