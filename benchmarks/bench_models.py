@@ -33,8 +33,8 @@ def sam_spec(variant: str, tiny: bool) -> tuple[Callable[[], Any], Callable[[Any
     from transformers import SamConfig, SamModel
 
     if tiny:
-        vc = dict(hidden_size=64, num_hidden_layers=2, num_attention_heads=2, image_size=256, patch_size=16,
-                  output_channels=32, global_attn_indexes=[1], window_size=4, num_pos_feats=16)
+        vc = dict(hidden_size=32, num_hidden_layers=1, num_attention_heads=2, image_size=64, patch_size=8,
+                  output_channels=16, mlp_dim=32, global_attn_indexes=[0], window_size=4, num_pos_feats=8)
     else:
         vc = {"vit_h": dict(hidden_size=1280, num_hidden_layers=32, num_attention_heads=16, global_attn_indexes=[7, 15, 23, 31]),
               "vit_b": dict(hidden_size=768, num_hidden_layers=12, num_attention_heads=12, global_attn_indexes=[2, 5, 8, 11])}[variant]
@@ -63,8 +63,8 @@ def gdino_spec(tiny: bool) -> tuple[Callable[[], Any], Callable[[Any, int, Any, 
             text_config=BertConfig(vocab_size=64, hidden_size=32, num_hidden_layers=1, num_attention_heads=2,
                                    intermediate_size=32, max_position_embeddings=64),
             d_model=32, encoder_layers=1, decoder_layers=2, encoder_ffn_dim=32, decoder_ffn_dim=32, encoder_attention_heads=2,
-            decoder_attention_heads=2, num_queries=50, encoder_n_points=2, decoder_n_points=2, max_text_len=32)
-        hw = (96, 128)
+            decoder_attention_heads=2, num_queries=20, encoder_n_points=2, decoder_n_points=2, max_text_len=32)
+        hw = (64, 96)
     else:
         cfg, hw = GroundingDinoConfig(), (800, 1066)  # defaults = Grounding DINO-T (Swin-T, BERT-base, 900 queries)
 

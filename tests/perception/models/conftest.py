@@ -23,6 +23,10 @@ import pytest  # noqa: E402
 torch = pytest.importorskip("torch")
 transformers = pytest.importorskip("transformers")
 
+# One intra-op thread: the tiny models gain nothing from more, and on a shared 2-core box torch's
+# spinning worker threads made each forward 10-50x slower under load.
+torch.set_num_threads(1)
+
 from react3d_core.data.frames import Frame, ImageRef, Intrinsics  # noqa: E402
 
 WORDS = "[PAD] [UNK] [CLS] [SEP] [MASK] . a photo of cabinet door drawer oven wardrobe table chair floor".split()
