@@ -100,6 +100,20 @@ def detections_from_outputs(processor: Any, out: Any, input_ids: torch.Tensor, s
     return dets
 
 
+def box_nms(boxes: np.ndarray, scores: np.ndarray, iou_threshold: float) -> np.ndarray:
+    """Indices kept by greedy non-maximum suppression (Grounded-SAM's demo uses IoU 0.8), best first."""
+    order = np.argsort(-scores, kind="stable")
+    area = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
+    keep: list[int] = []
+    while len(order):
+        i, rest = order[0], order[1:]
+        keep.append(int(i))
+        wh = (np.minimum(boxes[i, 2:], boxes[rest, 2:]) - np.maximum(boxes[i, :2], boxes[rest, :2])).clip(0)
+        inter = wh[:, 0] * wh[:, 1]
+        order = rest[inter / np.maximum(area[i] + area[rest] - inter, 1e-9) <= iou_threshold]
+    return np.array(keep, dtype=int)
+
+
 def sam_image_embeddings(sam: Loaded, images: Sequence[np.ndarray]) -> tuple[torch.Tensor, dict]:
     """One batched SAM image-encoder forward (the 600M-parameter part for ViT-H)."""
     inputs = sam.processor(images=list(images), return_tensors="pt")
@@ -150,8 +164,9 @@ def sam2_box_masks(sam: Loaded, image: np.ndarray, boxes: np.ndarray) -> np.ndar
 class GroundedSamSegmenter:
     """TextPromptSegmenter: Grounding DINO (box/text thresholds 0.3/0.25 in the paper) + SAM box prompts."""
 
-    def __init__(self, detector: Loaded, sam: Loaded, box_threshold: float, text_threshold: float, batch_size: int) -> None:
-        self.detector, self.sam = detector, sam
+    def __init__(self, detector: Loaded, sam: Loaded, box_threshold: float, text_threshold: float, batch_size: int,
+                 nms_iou: float = 0.8) -> None:
+        self.detector, self.sam, self.nms_iou = detector, sam, nms_iou
         self.box_threshold, self.text_threshold, self.batch_size = box_threshold, text_threshold, batch_size
 
     def groups(self, phrases: Sequence[str]) -> list[list[str]]:
@@ -173,6 +188,9 @@ class GroundedSamSegmenter:
             for group in self.groups(phrases):
                 for d, g in zip(dets, detect(self.detector, im, group, self.box_threshold, self.text_threshold)):
                     d.boxes, d.scores, d.labels = np.concatenate([d.boxes, g.boxes]), np.concatenate([d.scores, g.scores]), d.labels + g.labels
+            for d in dets:
+                k = box_nms(d.boxes, d.scores, self.nms_iou)
+                d.boxes, d.scores, d.labels = d.boxes[k].reshape(-1, 4), d.scores[k], [d.labels[j] for j in k]
             want = [i for i, d in enumerate(dets) if len(d.boxes)]
             emb = inputs = None
             if want and not is_sam2(self.sam):

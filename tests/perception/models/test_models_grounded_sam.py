@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 import torch
 
-from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, detect, detections_from_outputs,
+from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, box_nms, detect, detections_from_outputs,
                                        detector_prompt, masks_to_original, match_phrase, phrase_groups,
                                        to_sam_input)
 from tasks.models.loaders import load_detector, load_sam
@@ -133,5 +133,16 @@ def test_long_prompts_are_split_to_fit_the_text_length(loaded, make_frame, make_
     many = ["cabinet door", "drawer door", "oven door", "wardrobe door", "door", "table door", "chair door",
             "floor door", "cabinet drawer", "oven drawer", "wardrobe drawer"]  # 33+ tokens > 32
     assert len(seg.groups(many)) == 2
-    out = seg.segment([make_frame("a", 60, 80)], [make_image(60, 80, 0)], many)
-    assert len(out[0]) > 20  # 20 queries per prompt, two prompts
+    out = GroundedSamSegmenter(det, sam, 0.0, 0.0, batch_size=2, nms_iou=1.0).segment(
+        [make_frame("a", 60, 80)], [make_image(60, 80, 0)], many)
+    assert len(out[0]) > 20  # 20 queries per prompt, two prompts (NMS off)
+
+
+def test_box_nms_hand_computed():
+    """Boxes 0 and 1 overlap with IoU 81/119 = 0.68 (9x9 inside 10x10 shifted): suppressed at 0.5, kept at 0.8;
+    box 2 is disjoint. Order is by score."""
+    boxes = np.array([[0, 0, 10, 10], [1, 1, 11, 11], [20, 20, 30, 30]], float)
+    scores = np.array([0.5, 0.9, 0.7])
+    assert box_nms(boxes, scores, 0.5).tolist() == [1, 2]
+    assert box_nms(boxes, scores, 0.8).tolist() == [1, 2, 0]
+    assert box_nms(np.zeros((0, 4)), np.zeros(0), 0.8).tolist() == []
