@@ -43,13 +43,22 @@ class _Geometry:
         rays = np.concatenate([origins, dirs], 1).astype(np.float32)
         return self.scene.cast_rays(self._o3d.core.Tensor(rays))["t_hit"].numpy()
 
-    def distance_excluding(self, own: np.ndarray):  # noqa: ANN201
-        """Distance to the scan, ignoring faces flagged in ``own`` (the part and what is attached to it)."""
+    def distance_excluding(self, own: np.ndarray, front: np.ndarray | None = None, n: np.ndarray | None = None,
+                           behind_margin: float = 0.01):  # noqa: ANN201
+        """Distance to the scan, ignoring faces flagged in ``own`` (the part and what is attached to it)
+        and, given the part's front point and normal ``n`` (into the cavity), geometry that is not at
+        least ``behind_margin`` in front of the front plane: the part's own frame (jambs, carcass
+        edges) is built with clearance a scan cannot resolve, while what an opening part really hits
+        (a side wall, a neighbour that sticks out) stands in the room."""
 
         def dist(points: np.ndarray) -> np.ndarray:
             ans = self.scene.compute_closest_points(self._o3d.core.Tensor(np.asarray(points, np.float32)))
-            d = np.linalg.norm(ans["points"].numpy() - points, axis=1)
-            return np.where(own[ans["primitive_ids"].numpy().astype(np.int64)], np.inf, d)
+            cp = ans["points"].numpy().astype(float)
+            d = np.linalg.norm(cp - points, axis=1)
+            skip = own[ans["primitive_ids"].numpy().astype(np.int64)]
+            if front is not None and n is not None:
+                skip |= (cp - front) @ n > -behind_margin
+            return np.where(skip, np.inf, d)
 
         return dist
 
@@ -104,7 +113,8 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
         pts = mesh.vertices[p.vertex_ids]
         if len(pts) > 600:
             pts = pts[rng.choice(len(pts), 600, replace=False)]
-        art = set_limits(p.articulation, pts, pf.n, d_in, geo.distance_excluding(attached_faces(mesh, p, pf)), config.limits)
+        dist = geo.distance_excluding(attached_faces(mesh, p, pf), pf.center - pf.n * pf.thickness / 2, pf.n)
+        art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits)
         odir = out / "meshes" / oid
         part_mesh, _ = mesh.submesh(p.face_ids)
         save_mesh(odir / "part.ply", part_mesh)

@@ -4,7 +4,8 @@
 - d_hit: rays from the slab's mid-surface into the cavity (centre and 4 points at 0.1 x the longest
   edge), starting beyond 2 x the slab thickness so the part itself is not hit; the median hit;
 - d_image: the farthest scene depth behind the front plane seen around the part in the segmenting frame
-  (an upper bound: the wall behind a wall cabinet), used when at least 20 % of that band lies behind;
+  (an upper bound: the wall behind a wall cabinet), used when at least two sides of that band mostly
+  see behind it;
 - d_mesh: where the ray leaves the scan's bounding box.
 Depths are measured from the slab's back face.
 """
@@ -72,11 +73,16 @@ def d_image(pf: PartFrame, frame: Frame | None, depth: np.ndarray | None, cfg: C
     pw = pc @ frame.c2w[:3, :3].T + frame.c2w[:3, 3]
     rel = pw - pf.back
     a, b, c = rel @ pf.u, rel @ pf.v, rel @ pf.n
-    band = (np.abs(a) <= 0.65 * pf.su) & (np.abs(b) <= 0.65 * pf.sv) & ~((np.abs(a) <= 0.5 * pf.su) & (np.abs(b) <= 0.5 * pf.sv))
-    behind = c[band & (c > 0.02)]
-    # only a real view of what lies behind (a wall around a wall cabinet) bounds the depth; a sliver of
-    # plinth recess or a gap does not
-    if band.sum() == 0 or len(behind) < 0.2 * band.sum():
+    inner = (np.abs(a) <= 0.5 * pf.su) & (np.abs(b) <= 0.5 * pf.sv)
+    band = (np.abs(a) <= 0.65 * pf.su) & (np.abs(b) <= 0.65 * pf.sv) & ~inner
+    deep = band & (c > 0.02)
+    behind = c[deep]
+    # only a real view past the furniture (a wall around a wall cabinet) bounds the depth: deep pixels
+    # on at least two sides of the part, each side mostly deep; a toe-kick recess below a bottom
+    # drawer or the gaps between drawers see only one side or a sliver
+    sides = [a < -0.5 * pf.su, a > 0.5 * pf.su, b < -0.5 * pf.sv, b > 0.5 * pf.sv]
+    seen = sum(1 for sd in sides if (band & sd).sum() > 0 and (deep & sd).sum() >= 0.5 * (band & sd).sum())
+    if band.sum() == 0 or len(behind) < 0.2 * band.sum() or seen < 2:
         return np.inf
     return float(behind.max())
 

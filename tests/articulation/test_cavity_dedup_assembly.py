@@ -118,6 +118,18 @@ def test_revolute_limit_stops_at_a_wall() -> None:
     assert drawer.upper == pytest.approx(0.48) and drawer.limit_source == "cavity"
 
 
+def test_sweep_distance_ignores_the_parts_own_frame() -> None:
+    """Front plane y = 0, cavity along +y: a jamb behind the plane is ignored, a post in the room is not."""
+    m = MeshBuilder(edge=0.05)
+    m.add_box([0.62, 0.0, 0], [0.7, 0.3, 1.0], (200, 200, 200), key="jamb")
+    m.add_box([-0.3, -0.5, 0], [-0.2, -0.1, 1.0], (200, 200, 200), key="post")
+    mesh, _, _ = m.build()
+    dist = _Geometry(mesh).distance_excluding(np.zeros(mesh.n_faces, bool), np.zeros(3), np.array([0, 1.0, 0]))
+    d = dist(np.array([[0.61, 0.1, 0.5], [-0.19, -0.3, 0.5]]))
+    assert np.isinf(d[0])  # 1 cm from the jamb, but the jamb is behind the front plane
+    assert d[1] == pytest.approx(0.01, abs=1e-6)  # 1 cm from the post (x = -0.2), which stands in the room
+
+
 def _ablation_module():  # noqa: ANN202
     import importlib.util
     from pathlib import Path
