@@ -44,12 +44,13 @@ class _Geometry:
         return self.scene.cast_rays(self._o3d.core.Tensor(rays))["t_hit"].numpy()
 
     def distance_excluding(self, own: np.ndarray, front: np.ndarray | None = None, n: np.ndarray | None = None,
-                           behind_margin: float = 0.01):  # noqa: ANN201
+                           behind_margin: float = 0.01, with_points: bool = False):  # noqa: ANN201
         """Distance to the scan, ignoring faces flagged in ``own`` (the part and what is attached to it)
         and, given the part's front point and normal ``n`` (into the cavity), geometry that is not at
         least ``behind_margin`` in front of the front plane: the part's own frame (jambs, carcass
         edges) is built with clearance a scan cannot resolve, while what an opening part really hits
-        (a side wall, a neighbour that sticks out) stands in the room."""
+        (a side wall, a neighbour that sticks out) stands in the room. ``with_points``: also return the
+        closest points (the sweep checks whether the part moves into them or only past them)."""
 
         def dist(points: np.ndarray) -> np.ndarray:
             ans = self.scene.compute_closest_points(self._o3d.core.Tensor(np.asarray(points, np.float32)))
@@ -58,7 +59,8 @@ class _Geometry:
             skip = own[ans["primitive_ids"].numpy().astype(np.int64)]
             if front is not None and n is not None:
                 skip |= (cp - front) @ n > -behind_margin
-            return np.where(skip, np.inf, d)
+            d = np.where(skip, np.inf, d)
+            return (d, cp) if with_points else d
 
         return dist
 
@@ -113,8 +115,11 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
         pts = mesh.vertices[p.vertex_ids]
         if len(pts) > 600:
             pts = pts[rng.choice(len(pts), 600, replace=False)]
-        dist = geo.distance_excluding(attached_faces(mesh, p, pf), pf.center - pf.n * pf.thickness / 2, pf.n)
-        art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits)
+        own = attached_faces(mesh, p, pf)
+        dist = geo.distance_excluding(own, pf.center - pf.n * pf.thickness / 2, pf.n, with_points=True)
+        own_faces = np.zeros(mesh.n_faces, bool)
+        own_faces[p.face_ids] = True  # closed distances: everything but the part itself (gaps it glides along)
+        art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits, geo.distance_excluding(own_faces))
         odir = out / "meshes" / oid
         part_mesh, _ = mesh.submesh(p.face_ids)
         save_mesh(odir / "part.ply", part_mesh)

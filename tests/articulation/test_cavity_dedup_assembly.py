@@ -109,6 +109,9 @@ def test_revolute_limit_stops_at_a_wall() -> None:
     # the free edge (r = 0.6) reaches the wall plane x = -0.1 + clearance when 0.6 cos(q) = -0.09
     expect = np.pi - np.arccos(0.09 / 0.6)
     assert src == "sweep" and q == pytest.approx(expect, abs=np.radians(2.5))
+    # with closest points the wall is ahead of the free edge: same stop
+    q2, src2 = revolute_limit(a, door, geo.distance_excluding(own, with_points=True), cfg)
+    assert src2 == "sweep" and q2 == pytest.approx(expect, abs=np.radians(2.5))
     # the axis sign is fixed so that q > 0 opens out of the cavity (+y is into the cavity)
     flipped = set_limits(a.model_copy(update={"axis": (0, 0, 1)}), door, np.array([0, 1.0, 0]), None, None, cfg)
     np.testing.assert_allclose(flipped.axis, [0, 0, -1]) and flipped.limit_source == "cap"
@@ -128,6 +131,21 @@ def test_sweep_distance_ignores_the_parts_own_frame() -> None:
     d = dist(np.array([[0.61, 0.1, 0.5], [-0.19, -0.3, 0.5]]))
     assert np.isinf(d[0])  # 1 cm from the jamb, but the jamb is behind the front plane
     assert d[1] == pytest.approx(0.01, abs=1e-6)  # 1 cm from the post (x = -0.2), which stands in the room
+
+
+def test_sweep_glides_under_a_trim_beside_its_path() -> None:
+    """A head trim 3 mm above the door's top edge, in the room: the door swings under it (cap), while a
+    distance-only check (no closest points) stops it at the first step."""
+    m = MeshBuilder(edge=0.05)
+    m.add_box([-0.2, -1.0, 0.703], [1.0, -0.02, 0.8], (200, 200, 200))  # underside z = 0.703, in the room (y < -2 cm)
+    trim, _, _ = m.build()
+    geo = _Geometry(trim)
+    own = np.zeros(trim.n_faces, bool)
+    door = np.stack(np.meshgrid(np.linspace(0.02, 0.6, 30), [0.0], np.linspace(0.1, 0.7, 10)), -1).reshape(-1, 3)
+    a = Articulation(joint_type="revolute", axis=(0, 0, -1), origin=(0.0, 0.0, 0.4))  # q > 0 swings to -y
+    cfg = LimitConfig(revolute_max_deg=90, revolute_step_deg=5.0)
+    assert revolute_limit(a, door, geo.distance_excluding(own, with_points=True), cfg) == (pytest.approx(np.pi / 2), "cap")
+    assert revolute_limit(a, door, geo.distance_excluding(own), cfg)[1] == "sweep"
 
 
 def _ablation_module():  # noqa: ANN202
