@@ -65,9 +65,11 @@ def _camera_for(centers: np.ndarray, dirs: np.ndarray, point: np.ndarray) -> int
 
 
 def oracle_parts(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7.0, origin_noise_m: float = 0.2,
-                 config: PipelineConfig | None = None, refine: bool = True) -> tuple[SceneInput, TriMesh, list[tuple[ArticulatedPart, Articulation]]]:
+                 config: PipelineConfig | None = None, refine: bool = True, vertex_noise_m: float = 0.0,
+                 ) -> tuple[SceneInput, TriMesh, list[tuple[ArticulatedPart, Articulation]]]:
     """Oracle segmentation of a synthetic scene: one ``ArticulatedPart`` per GT movable part (with its
-    handle), initial joint = noisy GT, refined by the stage's code; paired with the GT joint."""
+    handle), initial joint = noisy GT, refined by the stage's code; paired with the GT joint.
+    ``vertex_noise_m``: Gaussian noise on the part's points before fitting (scan noise)."""
     cfg = config or PipelineConfig()
     scene_dir = Path(scene_dir)
     scene = load_scene(scene_dir)
@@ -87,7 +89,7 @@ def oracle_parts(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7
         h = by_id.get(handle_of.get(p.part_id, -1))
         if h is not None:
             vids, fids = np.union1d(vids, h.vert_indices), np.union1d(fids, h.tri_indices)
-        pts = mesh.vertices[vids]
+        pts = mesh.vertices[vids] + (rng.normal(0.0, vertex_noise_m, (len(vids), 3)) if vertex_noise_m > 0 else 0.0)
         cam = _camera_for(centers, dirs, pts.mean(0))
         fit = fit_part(pts, centers[cam], None, cfg.articulation.flat_ratio)
         initial = perturb(p.articulation, rng, axis_noise_deg, origin_noise_m)
@@ -100,9 +102,9 @@ def oracle_parts(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7
 
 
 def ablate_scene(scene_dir: str | Path, seed: int = 0, axis_noise_deg: float = 7.0, origin_noise_m: float = 0.2,
-                 config: PipelineConfig | None = None) -> list[dict]:
+                 config: PipelineConfig | None = None, vertex_noise_m: float = 0.0) -> list[dict]:
     """One row per GT movable part: errors with and without refinement (same noise draw)."""
-    _, _, parts = oracle_parts(scene_dir, seed, axis_noise_deg, origin_noise_m, config)
+    _, _, parts = oracle_parts(scene_dir, seed, axis_noise_deg, origin_noise_m, config, vertex_noise_m=vertex_noise_m)
     rows = []
     for part, gt in parts:
         oe0, md0 = joint_errors(part.initial, gt)
@@ -144,6 +146,7 @@ def main(argv: list[str] | None = None) -> dict:
     ap.add_argument("--frames", type=int, default=12)
     ap.add_argument("--work", default=None, help="where generated scenes go (default: a temp dir)")
     ap.add_argument("--json", default=None)
+    ap.add_argument("--vertex-noise", type=float, default=0.0, help="Gaussian scan noise (m) on part points")
     ap.add_argument("--no-cavity", action="store_true", help="skip assembling the scenes (cavity depth check)")
     args = ap.parse_args(argv)
     dirs = [Path(d) for d in args.scene_dir]
@@ -157,7 +160,7 @@ def main(argv: list[str] | None = None) -> dict:
                 generate_scene(d, seed=s, n_frames=args.frames)
             dirs.append(d)
     t0 = time.perf_counter()
-    rows = [r for i, d in enumerate(dirs) for r in ablate_scene(d, seed=i)]
+    rows = [r for i, d in enumerate(dirs) for r in ablate_scene(d, seed=i, vertex_noise_m=args.vertex_noise)]
     res = {"summary": summarize(rows), "per_scene": {d.name: summarize([r for r in rows if r["scene"] == d.name]) for d in dirs},
            "seconds": time.perf_counter() - t0, "rows": rows}
     s = res["summary"]
