@@ -20,7 +20,7 @@ from .refine import is_flat, refine_prismatic, refine_revolute, slab_mid_and_thi
 from .types import ArticulatedPart
 from .validate import best_prediction, lift_prediction
 
-STAGE_VERSION = "1"
+STAGE_VERSION = "2"
 __all__ = ["STAGE_VERSION", "ArticulatedPart", "PartFit", "articulate_candidate", "fit_part", "min_obb",
            "refine_articulation"]
 

@@ -24,7 +24,7 @@ from ..data.mesh import TriMesh, save_mesh
 from ..data.parts import InteractiveObject, InteractiveScene, save_vertex_ids
 from ..dedup import remove_duplicates
 
-STAGE_VERSION = "1"
+STAGE_VERSION = "2"
 __all__ = ["STAGE_VERSION", "assemble_scene", "carve_background"]
 
 

@@ -20,7 +20,7 @@ from ..config import CavityConfig
 from ..data.frames import Frame
 from ..data.mesh import TriMesh
 
-STAGE_VERSION = "1"
+STAGE_VERSION = "2"
 
 
 @dataclass
