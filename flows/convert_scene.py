@@ -107,7 +107,7 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
     formats = list(cfg.export.formats)
     prog.start("export", 1)
     exp = export(asm, c["export"], formats)
-    manifest = publish(exp, out_dir)
+    manifest = publish(exp, out_dir, fp["mesh_path"])
     prog.advance("export", 1)
     timings["export"] = time.perf_counter() - t
 

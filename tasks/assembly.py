@@ -77,15 +77,18 @@ def export(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: list[
     return export_body(assembled, export_cfg, formats)
 
 
-def publish_body(result: dict[str, Any], out_dir: str) -> str:
-    """Copy the finished folder to ``out_dir`` as a whole (atomic rename); returns the manifest path."""
+def publish_body(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None) -> str:
+    """Copy the finished folder to ``out_dir`` as a whole (atomic rename); returns the manifest path.
+
+    The stored result is keyed by content, so it may come from a run on another copy of the scan:
+    ``scan_mesh_path`` (this run's mesh) is what the published manifest refers to."""
     from react3d_core.data.parts import InteractiveScene
 
     src = Path(result["path"]).parent
     out = Path(out_dir).resolve()
     manifest = InteractiveScene.load(src / "scene.json")
-    mesh = Path(manifest.input_mesh)
-    mesh = mesh if mesh.is_absolute() else (src / mesh).resolve()
+    mesh = Path(scan_mesh_path) if scan_mesh_path else Path(manifest.input_mesh)
+    mesh = mesh.resolve() if mesh.is_absolute() or scan_mesh_path else (src / mesh).resolve()
     with atomic_dir(out) as tmp:
         shutil.copytree(src, tmp, dirs_exist_ok=True)
         # the scan mesh stays where it is: re-point the manifest's reference from the new folder
@@ -95,5 +98,5 @@ def publish_body(result: dict[str, Any], out_dir: str) -> str:
 
 
 @task(name="publish", persist_result=False)
-def publish(result: dict[str, Any], out_dir: str) -> str:
-    return publish_body(result, out_dir)
+def publish(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None) -> str:
+    return publish_body(result, out_dir, scan_mesh_path)

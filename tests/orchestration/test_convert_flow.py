@@ -56,6 +56,13 @@ def test_convert_then_everything_cached(scene: Path, tmp_path: Path, monkeypatch
     second = time.perf_counter() - t0
     assert [len(c) for c in counts] == [0, 0, 0]
     assert len(InteractiveScene.load(manifest2).objects) == len(m.objects)
+    # the same scan copied elsewhere hits the same cache, and the result refers to the copy's mesh
+    copy = tmp_path / "copy"
+    shutil.copytree(scene, copy)
+    manifest3 = convert_scene(str(copy), str(tmp_path / "c"), cfg)
+    assert [len(c) for c in counts] == [0, 0, 0]
+    m3 = InteractiveScene.load(manifest3)
+    assert (Path(manifest3).parent / m3.input_mesh).resolve() == (copy / "scans" / "mesh_aligned_0.05.ply").resolve()
     assert second < first
 
 
