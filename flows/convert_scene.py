@@ -106,10 +106,12 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
     t = time.perf_counter()
     formats = list(cfg.export.formats)
     prog.start("export", 1)
-    exp = export(asm, c["export"], formats)
+    # no formats (accuracy benchmarks): publish the assembled scene without simulator files
+    exp = export(asm, c["export"], formats) if formats else asm
     manifest = publish(exp, out_dir, fp["mesh_path"])
     prog.advance("export", 1)
-    timings["export"] = time.perf_counter() - t
+    if formats:
+        timings["export"] = time.perf_counter() - t
 
     metrics = None
     if fp["gt_dir"]:

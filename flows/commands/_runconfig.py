@@ -17,7 +17,7 @@ def add_pipeline_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--no-refine", action="store_true", help="Keep the predictor's joints (refinement ablation).")
     p.add_argument("--stride", type=int, default=None, help="Use every n-th frame (default from config: 5).")
     p.add_argument("--max-frames", type=int, default=None, help="Cap on frames used.")
-    p.add_argument("--formats", default=None, help="Export formats, e.g. urdf,usd,mjcf.")
+    p.add_argument("--formats", default=None, help="Export formats, e.g. urdf,usd,mjcf ('none': no simulator files).")
 
 
 def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
@@ -45,7 +45,7 @@ def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
     if args.max_frames:
         put(("frames", "max_frames"), args.max_frames)
     if args.formats:
-        put(("export", "formats"), [f.strip() for f in args.formats.split(",") if f.strip()])
+        put(("export", "formats"), [f.strip() for f in args.formats.split(",") if f.strip() and f.strip() != "none"])
     from react3d_core.config import PipelineConfig
 
     PipelineConfig().with_overrides(cfg)  # validate now: one clear error before Prefect starts

@@ -30,7 +30,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--json", dest="json_path", help="Write the metrics JSON here.")
     p.add_argument("--out", default="bench_out", help="Work folder: generated scenes, results, reports.")
     p.add_argument("--frames", type=int, help="Override the set's frame count for generated scenes.")
-    p.add_argument("--formats", default=None, help="Export formats (default: the config's urdf,usd,mjcf).")
+    p.add_argument("--formats", default=None,
+                   help="Export formats (default: the config's urdf,usd,mjcf; 'none' skips export for accuracy-only runs).")
     p.add_argument("--stride", type=int, default=1,
                    help="Frame stride (default 1: synthetic captures are already sparse; use 5 for raw ScanNet++ iPhone).")
 
@@ -148,7 +149,7 @@ def run(args: argparse.Namespace) -> int:
     entries = load_spec(args.scenes, out_dir, args.frames)
     config: dict[str, Any] = {"perception": {"backend": args.perception}, "frames": {"stride": args.stride}}
     if args.formats:
-        config["export"] = {"formats": [f.strip() for f in args.formats.split(",") if f.strip()]}
+        config["export"] = {"formats": [f.strip() for f in args.formats.split(",") if f.strip() and f.strip() != "none"]}
     if args.no_refine:
         config["articulation"] = {"refine": False}
     result = run_bench(entries, out_dir, config)
