@@ -84,12 +84,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=100)
     ap.add_argument("--kind", default="kitchen")
     ap.add_argument("--perception", default="oracle", choices=("oracle", "heuristic", "models"))
+    ap.add_argument("--formats", default="urdf,usd,mjcf", help="Export formats ('none' to time the pipeline without export).")
     ap.add_argument("--out", default="scaling_out")
     args = ap.parse_args(argv)
     from react3d_core.synthetic import generate_scene
 
     out = Path(args.out)
-    config = {"perception": {"backend": args.perception}}
+    # every generated frame is used (stride 1): the frame axis is the number of frames processed
+    config = {"perception": {"backend": args.perception}, "frames": {"stride": 1},
+              "export": {"formats": [f for f in args.formats.split(",") if f and f != "none"]}}
     result: dict[str, Any] = {"config": config, "seed": args.seed, "kind": args.kind, "vs_frames": [], "vs_faces": []}
     for n in args.frames:
         sd = out / "scenes" / f"f{n}"
