@@ -2,8 +2,9 @@
 with a handle in front of them or a coplanar neighbour front — and a joint guessed from shape + handle.
 
 Rules (a heuristic, see docs/perception.md for its limits):
-- type: a horizontal handle on a low front (h <= ``drawer_max_h``) or a low wide handle-less front
-  -> drawer (prismatic, pulled along the front normal); a horizontal handle low on a tall front ->
+- type: a horizontal handle on a low front (h <= ``drawer_max_h``) or a low handle-less front that is
+  wide or stacked with a same-width front -> drawer (prismatic, pulled along the front normal); a
+  horizontal handle low on a tall front ->
   top-hinged flap; high on a tall front -> bottom-hinged drop door; otherwise a vertical hinge;
 - hinge side: opposite the handle; without a handle, away from an adjacent coplanar neighbour of the
   same height (door pairs), else the left edge.
@@ -183,7 +184,8 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
         hcu, hcv = float(hu.mean()), float(hv.mean())
     else:
         horizontal, hcu, hcv = None, cu, cv
-    if (horizontal and f.h <= r.drawer_max_h) or (hpts is None and f.h <= r.drawer_max_h and f.w >= f.h):
+    stacked = any(side == "vertical" for _, side in neighbours)  # a same-width front above/below: a stack
+    if (horizontal and f.h <= r.drawer_max_h) or (hpts is None and f.h <= r.drawer_max_h and (f.w >= f.h or stacked)):
         return "drawer", Articulation(joint_type="prismatic", axis=f.n_out, origin=centre, lower=0.0, upper=0.3,
                                       limit_source="heuristic")
     if horizontal:
