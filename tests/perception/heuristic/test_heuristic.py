@@ -105,3 +105,17 @@ def test_backend_masks_match_gt_part_ids(synthetic_scene) -> None:  # noqa: ANN0
             assert (back.mask == ms[0].mask).all()
     # handles are separate GT parts, so a front+handle mask scores a little below 1 against the front
     assert len(ious) > 10 and np.median(ious) > 0.8
+
+
+def test_low_square_handleless_front_under_a_door_is_a_drawer() -> None:
+    """Wardrobe column: a 0.40 x 0.41 m handle-less front under a tall door (same width) is a drawer
+    (stack rule); it is taller than wide, so without its neighbour it would read as a door."""
+    m = MeshBuilder(edge=0.05)
+    m.add_box([0, 0.0, 0], [0.4, 0.6, 2.1], (200, 200, 200))
+    m.add_box([0.0, -0.02, 0.0], [0.4, -0.001, 0.41], (150, 100, 80))    # square drawer front
+    m.add_box([0.0, -0.02, 0.42], [0.4, -0.001, 2.06], (150, 100, 80))   # tall door above (1 cm gap)
+    mesh, _, _ = m.build()
+    facets = planar_facets(mesh)
+    fronts = find_fronts(mesh, facets, _visible(mesh, facets), np.array([0.2, -2.0, 1.2]))
+    kinds = sorted((round(float(f.center[2]), 1), f.kind) for f in fronts)
+    assert [k for _, k in kinds] == ["drawer", "door"]
