@@ -57,6 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--json", default=None)
     a = p.parse_args(argv)
     work = Path(a.work)
+    (work / "prefect").mkdir(parents=True, exist_ok=True)
     os.environ.setdefault("PREFECT_HOME", str(work / "prefect"))
     os.environ.setdefault("REACT3D_CACHE", str(work / "cache"))
     from tasks import prefect_env
