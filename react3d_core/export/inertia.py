@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import warnings
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -25,8 +27,13 @@ class Inertial:
         return self.axes @ np.diag(self.moments) @ self.axes.T
 
     def rpy(self) -> np.ndarray:
-        """URDF rpy (extrinsic XYZ) of the principal frame."""
-        return Rotation.from_matrix(self.axes).as_euler("xyz")
+        """URDF rpy (extrinsic XYZ) of the principal frame.
+
+        Principal axes of symmetric parts are often axis-aligned (gimbal lock): any valid rpy of the same
+        rotation is fine for URDF, so SciPy's warning about it is silenced."""
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", UserWarning)
+            return Rotation.from_matrix(self.axes).as_euler("xyz")
 
     def quat_wxyz(self) -> np.ndarray:
         x, y, z, w = Rotation.from_matrix(self.axes).as_quat()
