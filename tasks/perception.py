@@ -42,10 +42,10 @@ def get_perception(scene: SceneInput, cfg: PerceptionConfig) -> Perception:
     return _BACKENDS[key]
 
 
-def openable_phrases(tags: Sequence[str], kept: Sequence[str], cfg: PerceptionConfig) -> list[str]:
+def openable_phrases(kept: Sequence[str], cfg: PerceptionConfig) -> list[str]:
     """Text prompts for the segmenter: each kept tag as '<tag> door' (paper), 'door' itself as is."""
     out = []
-    for t in sorted(set(kept) | (set(cfg.always_keep_tags) & set(tags)) | set(cfg.always_keep_tags)):
+    for t in sorted(set(kept) | set(cfg.always_keep_tags)):
         out.append(t if t.endswith("door") or t in cfg.always_keep_tags else t + cfg.prompt_suffix)
     return out
 
@@ -76,7 +76,7 @@ def perceive_body(scene_path: str, frames_cfg: dict[str, Any], frame_ids: list[s
     tags = split_on_oom(lambda fr, im: perc.tagger.tag(fr, im), frames, images)
     all_tags = sorted({t for ts in tags for t in ts})
     kept = perc.tag_filter.filter(all_tags) if all_tags else []
-    phrases = openable_phrases(all_tags, kept, cfg)
+    phrases = openable_phrases(kept, cfg)
     masks = split_on_oom(lambda fr, im: perc.segmenter.segment(fr, im, phrases), frames, images)
     preds = split_on_oom(lambda fr, im: perc.articulation.predict(fr, im), frames, images)
     result = {

@@ -103,3 +103,11 @@ def test_oom_splits_batches() -> None:
     assert calls[0] == 5 and max(calls[1:]) <= 3
     with pytest.raises(ValueError):
         split_on_oom(lambda f, i: (_ for _ in ()).throw(ValueError("bug")), [1, 2], [None] * 2)
+
+
+def test_openable_phrases_follow_the_paper() -> None:
+    from react3d_core.config import PerceptionConfig
+    from tasks.perception import openable_phrases
+
+    assert openable_phrases(["cabinet", "refrigerator"], PerceptionConfig()) == ["cabinet door", "door", "refrigerator door"]
+    assert openable_phrases([], PerceptionConfig()) == ["door"]  # 'door' is always kept
