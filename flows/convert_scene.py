@@ -9,7 +9,8 @@ crashed run resumes from the last finished task.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from typing import Any
 
 from tasks import prefect_env
@@ -49,6 +50,20 @@ def config_sections(c: dict[str, Any], keys: tuple[str, ...]) -> dict[str, Any]:
 PROGRESS_HOOK: Callable[[str, int, int], None] | None = None
 
 
+@contextmanager
+def _stage(name: str, total: int, prog: Progress, timings: dict[str, float]) -> Iterator[Callable[..., Any]]:
+    """Time a stage into ``timings`` and report progress; ``done(x, n=1)`` advances and returns ``x``."""
+    t = time.perf_counter()
+    prog.start(name, total)
+
+    def done(x: Any = None, n: int = 1) -> Any:
+        prog.advance(name, n)
+        return x
+
+    yield done
+    timings[name] = time.perf_counter() - t
+
+
 def _chunks(items: list[str], n: int) -> list[list[str]]:
     return [items[i:i + n] for i in range(0, len(items), n)]
 
@@ -67,51 +82,29 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
     fp = fingerprint_scene(scene_path, frames_cfg)
     timings["load"] = time.perf_counter() - t
     sha = fp["sha256"]
-    ids = fp["frame_ids"]
-    batch = max(1, cfg.perception.batch_size)
-    prog.start("perception", len(ids))
+    batches = _chunks(fp["frame_ids"], max(1, cfg.perception.batch_size))
 
-    t = time.perf_counter()
-    tags = ["gpu"] if cfg.perception.backend == "models" else []
-    futs = [perceive_frames.with_options(tags=tags).submit(scene_path, sha, frames_cfg, b, c["perception"])
-            for b in _chunks(ids, batch)]
-    perc = []
-    for f, b in zip(futs, _chunks(ids, batch)):
-        perc.append(f.result())
-        prog.advance("perception", len(b))
-    timings["perception"] = time.perf_counter() - t
+    with _stage("perception", len(fp["frame_ids"]), prog, timings) as done:
+        tags = ["gpu"] if cfg.perception.backend == "models" else []
+        futs = [perceive_frames.with_options(tags=tags).submit(scene_path, sha, frames_cfg, b, c["perception"]) for b in batches]
+        perc = [done(f.result(), len(b)) for f, b in zip(futs, batches)]
 
-    t = time.perf_counter()
-    prog.start("segmentation", 1)
-    seg = segment_scene(scene_path, sha, frames_cfg, perc, config_sections(c, SEGMENTATION_KEYS))
-    prog.advance("segmentation", 1)
-    timings["segmentation"] = time.perf_counter() - t
+    with _stage("segmentation", 1, prog, timings) as done:
+        seg = done(segment_scene(scene_path, sha, frames_cfg, perc, config_sections(c, SEGMENTATION_KEYS)))
 
-    t = time.perf_counter()
-    prog.start("articulation", seg["n"])
-    ac = config_sections(c, ARTICULATION_KEYS)
-    afuts = [articulate_part.submit(scene_path, sha, frames_cfg, seg, i, perc, ac) for i in range(seg["n"])]
-    parts = []
-    for f in afuts:
-        parts.append(f.result())
-        prog.advance("articulation", 1)
-    timings["articulation"] = time.perf_counter() - t
+    with _stage("articulation", seg["n"], prog, timings) as done:
+        ac = config_sections(c, ARTICULATION_KEYS)
+        futs = [articulate_part.submit(scene_path, sha, frames_cfg, seg, i, perc, ac) for i in range(seg["n"])]
+        parts = [done(f.result()) for f in futs]
 
-    t = time.perf_counter()
-    prog.start("assembly", 1)
-    asm = assemble(scene_path, sha, frames_cfg, parts, config_sections(c, ASSEMBLY_KEYS))
-    prog.advance("assembly", 1)
-    timings["assembly"] = time.perf_counter() - t
+    with _stage("assembly", 1, prog, timings) as done:
+        asm = done(assemble(scene_path, sha, frames_cfg, parts, config_sections(c, ASSEMBLY_KEYS)))
 
-    t = time.perf_counter()
     formats = list(cfg.export.formats)
-    prog.start("export", 1)
-    # no formats (accuracy benchmarks): publish the assembled scene without simulator files
-    exp = export(asm, c["export"], formats) if formats else asm
-    manifest = publish(exp, out_dir, fp["mesh_path"])
-    prog.advance("export", 1)
-    if formats:
-        timings["export"] = time.perf_counter() - t
+    with _stage("export", 1, prog, timings if formats else {}) as done:
+        # no formats (accuracy benchmarks): publish the assembled scene without simulator files
+        exp = export(asm, c["export"], formats) if formats else asm
+        manifest = done(publish(exp, out_dir, fp["mesh_path"]))
 
     metrics = None
     if fp["gt_dir"]:
@@ -121,11 +114,8 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
     timings["total"] = time.perf_counter() - t_all
     versions = {m: stage_version(m) for m in STAGE_MODULES}
     finalize(manifest, c, versions, timings)
-    t = time.perf_counter()
-    prog.start("report", 1)
-    html = report(manifest, scene_path, frames_cfg, metrics)
-    prog.advance("report", 1)
-    timings["report"] = time.perf_counter() - t
+    with _stage("report", 1, prog, timings) as done:
+        html = done(report(manifest, scene_path, frames_cfg, metrics))
     finalize(manifest, c, versions, timings)
     publish_scene_artifacts(fp["scene_id"], manifest, html, timings, metrics,
                             n_candidates=seg["n"], n_rejected=sum(p.get("kind") == "rejected" for p in parts))
