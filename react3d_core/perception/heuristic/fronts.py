@@ -99,18 +99,21 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
     cands = _drop_covered(cands)
     # handles: small visible facets just in front of a candidate, inside its rectangle (nearest plane wins)
     small = np.flatnonzero(visible & (facets.areas <= rules.handle_max_area))
-    for s in small:
-        c = fcent[s]
-        best, best_d = None, np.inf
-        for f in cands:
-            d = float(np.dot(c - f.center, f.n_out))
-            if not (rules.handle_depth[0] < d < rules.handle_depth[1]) or d >= best_d:
-                continue
-            cu, cv = float(c @ f.u), float(c[2])
-            if f.extent_u[0] + 0.005 < cu < f.extent_u[1] - 0.005 and f.extent_v[0] + 0.005 < cv < f.extent_v[1] - 0.005:
-                best, best_d = f, d
-        if best is not None:
-            best.handle_facets.append(int(s))
+    if len(small):
+        c = fcent[small]                                                     # (S,3)
+        centers = np.array([f.center for f in cands])                        # (C,3)
+        normals = np.array([f.n_out for f in cands])
+        us = np.array([f.u for f in cands])
+        eu = np.array([f.extent_u for f in cands])
+        ev = np.array([f.extent_v for f in cands])
+        d = np.einsum("scx,cx->sc", c[:, None, :] - centers[None], normals)   # depth in front of each plane
+        cu, cv = c @ us.T, c[:, 2:3]
+        ok = ((rules.handle_depth[0] < d) & (d < rules.handle_depth[1])
+              & (eu[:, 0] + 0.005 < cu) & (cu < eu[:, 1] - 0.005) & (ev[:, 0] + 0.005 < cv) & (cv < ev[:, 1] - 0.005))
+        d = np.where(ok, d, np.inf)
+        best = d.argmin(1)
+        for s_id, k in zip(small[np.isfinite(d.min(1))], best[np.isfinite(d.min(1))]):
+            cands[k].handle_facets.append(int(s_id))
     out = []
     for f in cands:
         neighbours = _neighbours(f, cands, rules)
