@@ -95,6 +95,19 @@ def time_export(bg) -> dict[str, float | int | str]:  # noqa: ANN001
     return rows
 
 
+def _bake_rows(name: str, mesh, cfg, rows: dict):  # noqa: ANN001, ANN202
+    """Bake ``mesh`` and record time, method, texture size and colour error under ``name``."""
+    from react3d_core.texture import bake_texture, vertex_color_error
+
+    t = time.perf_counter()
+    tm = bake_texture(mesh, cfg)
+    rows[f"{name} bake s"] = round(time.perf_counter() - t, 2)
+    rows[f"{name} method"] = tm.method
+    rows[f"{name} texture"] = f"{tm.image.shape[1]}x{tm.image.shape[0]}"
+    rows[f"{name} mean colour error /255"] = round(vertex_color_error(tm, mesh), 3)
+    return tm
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--faces", type=int, default=1_000_000)
@@ -104,18 +117,13 @@ def main(argv: list[str] | None = None) -> int:
     a = p.parse_args(argv)
 
     from react3d_core.config.export import ExportConfig
-    from react3d_core.texture import bake_texture, vertex_color_error, write_obj_folder
+    from react3d_core.texture import write_obj_folder
 
     cfg = ExportConfig()
     rows: dict[str, float | int | str] = {}
     bg = room(a.faces)
     rows["background faces"] = bg.n_faces
-    t = time.perf_counter()
-    tm = bake_texture(bg, cfg)
-    rows["background bake s"] = round(time.perf_counter() - t, 2)
-    rows["background method"] = tm.method
-    rows["background texture"] = f"{tm.image.shape[1]}x{tm.image.shape[0]}"
-    rows["background mean colour error /255"] = round(vertex_color_error(tm, bg), 3)
+    tm = _bake_rows("background", bg, cfg, rows)
     with tempfile.TemporaryDirectory() as d:
         t = time.perf_counter()
         write_obj_folder(tm, Path(d) / "bg")
@@ -130,12 +138,7 @@ def main(argv: list[str] | None = None) -> int:
     v = np.asarray(sphere.vertices)
     part = TriMesh(v, sphere.faces, np.clip(128 + 300 * v, 0, 255).astype(np.uint8))
     rows["part faces"] = part.n_faces
-    t = time.perf_counter()
-    ptm = bake_texture(part, cfg)
-    rows["part bake s"] = round(time.perf_counter() - t, 2)
-    rows["part method"] = ptm.method
-    rows["part texture"] = f"{ptm.image.shape[1]}x{ptm.image.shape[0]}"
-    rows["part mean colour error /255"] = round(vertex_color_error(ptm, part), 3)
+    _bake_rows("part", part, cfg, rows)
 
     if a.export:
         rows.update(time_export(bg))
