@@ -6,12 +6,14 @@ part made of the geometry of the links it moves (a link named ``*handle*`` becom
 child). Joint axes are flipped where needed so that q in [0, upper] opens. The object stands in a room
 shell, and the camera sweeps every group of fronts that face the same way.
 
-Cavity depths are not known for arbitrary URDFs: ``interior_depth`` is None.
+Cavity depths are not known for arbitrary URDFs: ``interior_depth`` is None. Internal geometry that a
+capture of the closed scene never sees (drawer boxes, appliance insides) is culled (``observed.py``).
 """
 
 from __future__ import annotations
 
 import re
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -39,7 +41,7 @@ def _color(geom, name: str) -> tuple[int, int, int]:  # noqa: ANN001
             return tuple(int(x) for x in c.mean(0))
     except Exception:  # noqa: BLE001 - visuals vary a lot between URDFs; fall back to a name colour
         pass
-    h = abs(hash(name)) % 997
+    h = zlib.crc32(name.encode()) % 997  # not hash(): str hashes change per process
     return (120 + h % 100, 110 + (h // 7) % 100, 100 + (h // 49) % 100)
 
 
@@ -128,7 +130,8 @@ def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "
     mesh, keys, key_ids = m.build()
     runs = _runs(mesh, keys, key_ids, parts, W, L)
     return SynthLayout(mesh, keys, key_ids, parts, statics, runs, (W, L, H), kind,
-                       extra={"urdf": str(path.name), "offset": offset.tolist(), "skipped_joints": [j.name for j in movable if SKIP.search(j.name)]})
+                       extra={"urdf": str(path.name), "offset": offset.tolist(), "skipped_joints": [j.name for j in movable if SKIP.search(j.name)]},
+                       observed_only=True)
 
 
 def _runs(mesh, keys, key_ids, parts: list[PartSpec], W: float, L: float) -> list[ViewRun]:  # noqa: ANN001
@@ -157,7 +160,25 @@ def _runs(mesh, keys, key_ids, parts: list[PartSpec], W: float, L: float) -> lis
         fr = WallFrame(R @ np.array([0.0, y_front, 0.0]), theta)
         loc = loc - np.array([0.0, y_front, 0.0])
         c = np.concatenate(vs).mean(0)
-        free = {0: W - c[0], 1: L - c[1], 2: c[0], 3: c[1]}[k]
+        free = min({0: W - c[0], 1: L - c[1], 2: c[0], 3: c[1]}[k],
+                   _free_depth(mesh, fr, float(loc[:, 0].min()), float(loc[:, 0].max()), out))
         runs.append(ViewRun(fr, float(loc[:, 0].min()), float(loc[:, 0].max()), float(loc[:, 2].min()),
                             float(loc[:, 2].max()), 0.0, float(free)))
     return runs
+
+
+def _free_depth(mesh, fr: WallFrame, x0: float, x1: float, out: np.ndarray) -> float:  # noqa: ANN001
+    """Free distance in front of a run at camera heights: furniture facing it across an aisle (an island
+    facing a counter) must not hide the fronts from the cameras meant to film them."""
+    import open3d as o3d
+
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(o3d.core.Tensor(mesh.vertices.astype(np.float32)), o3d.core.Tensor(mesh.faces.astype(np.uint32)))
+    T = fr.T
+    xs = np.linspace(x0, x1, 7)
+    starts = np.array([T[:3, :3] @ np.array([x, -0.05, z]) + T[:3, 3] for x in xs for z in (1.0, 1.3, 1.6)])
+    d = np.array([out[0], out[1], 0.0])
+    rays = np.concatenate([starts, np.broadcast_to(d, starts.shape)], 1).astype(np.float32)
+    t = scene.cast_rays(o3d.core.Tensor(rays))["t_hit"].numpy()
+    t = t[np.isfinite(t)]
+    return float(np.median(t)) + 0.05 if len(t) else np.inf

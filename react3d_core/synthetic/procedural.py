@@ -43,6 +43,9 @@ class SynthLayout:
     room: tuple[float, float, float]
     kind: str
     extra: dict = field(default_factory=dict)
+    # keep only surfaces a capture of the closed scene observes (see observed.py); URDF models hold
+    # internal geometry (drawer boxes, appliance insides) that no scan and no Articulate3D label has
+    observed_only: bool = False
 
 
 def wall_frames(W: float, L: float) -> list[tuple[WallFrame, float]]:

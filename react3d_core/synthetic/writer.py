@@ -21,10 +21,11 @@ from ..data.mesh import save_mesh
 from ..ground_truth.articulate3d import GroundTruth, GTPart, write_articulate3d
 from ..scene_io.depth_bin import write_depth_bin
 from .camera_path import camera_walk
+from .observed import keep_faces, observed_faces
 from .procedural import SynthLayout
 from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, sensor_depth
 
-GENERATOR_VERSION = "1"
+GENERATOR_VERSION = "2"  # 2: URDF sources keep only observed surfaces
 
 
 def _gt_parts(layout: SynthLayout) -> tuple[list[GTPart], np.ndarray, list[dict]]:
@@ -70,13 +71,17 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
         raise ValueError("n_frames must be >= 1")
     rng = np.random.default_rng(seed + 1_000_003)
     scene_id = scene_id or out_dir.name
-    gt_parts, face_pid, meta = _gt_parts(layout)
     K = base_intrinsics(rng)
     K_rgb, K_d = scale_K(K, RGB_SIZE[0]), scale_K(K, DEPTH_SIZE[0])
     if room_depths is None:
         room_depths = [5.0] * len(layout.runs)
     poses = camera_walk(layout.runs, n_frames, room_depths, rng)
     caster = RayCaster(layout.mesh)
+    if layout.observed_only:
+        dense = camera_walk(layout.runs, max(3 * n_frames, 240), room_depths, np.random.default_rng(seed + 7_777))
+        layout = keep_faces(layout, observed_faces(caster, dense + poses, K))
+        caster = RayCaster(layout.mesh)
+    gt_parts, face_pid, meta = _gt_parts(layout)
     with atomic_dir(out_dir) as tmp:
         (tmp / "iphone" / "rgb").mkdir(parents=True)
         (tmp / "iphone" / "gt_part_ids").mkdir(parents=True)

@@ -22,7 +22,8 @@ URDF = """<?xml version="1.0"?>
     <origin xyz="-0.29 -0.26 0.6"/><axis xyz="0 0 1"/><limit lower="-1.6" upper="0" effort="1" velocity="1"/></joint>
   <link name="door_handle"><visual><origin xyz="0.5 -0.03 0"/><geometry><box size="0.02 0.03 0.12"/></geometry></visual></link>
   <joint name="h" type="fixed"><parent link="door"/><child link="door_handle"/></joint>
-  <link name="drawer"><visual><geometry><box size="0.58 0.02 0.3"/></geometry></visual></link>
+  <link name="drawer"><visual><geometry><box size="0.58 0.02 0.3"/></geometry></visual>
+    <visual><origin xyz="0 0.2 0"/><geometry><box size="0.5 0.3 0.2"/></geometry></visual></link>
   <joint name="slide" type="prismatic"><parent link="corpus"/><child link="drawer"/>
     <origin xyz="0 -0.26 0.2"/><axis xyz="0 -1 0"/><limit lower="0" upper="0.4" effort="1" velocity="1"/></joint>
 </robot>
@@ -74,6 +75,30 @@ def test_urdf_scene_writes_gt(urdf_file: Path, tmp_path: Path) -> None:
     out = generate_scene(tmp_path / "u", source="urdf", urdf_path=urdf_file, n_frames=4)
     meta = json.loads((out / "synth_meta.json").read_text())
     assert [p["type"] for p in meta["parts"]] == ["revolute", "prismatic"]
+
+
+def test_unobserved_internal_geometry_is_culled(urdf_file: Path, tmp_path: Path) -> None:
+    """The drawer's box sits inside the solid corpus: no camera sees it, so (as in a real scan) neither
+    the mesh nor the drawer's GT faces keep it; the drawer front stays whole."""
+    from react3d_core.data.mesh import load_mesh
+    from react3d_core.ground_truth import read_articulate3d
+
+    layout = build_from_urdf(urdf_file, seed=0)
+    drawer_key = layout.key_ids["slide"]
+    y_front = 2.0 - 0.25 + layout.extra["offset"][1]  # corpus front face in the scene frame
+    full = layout.mesh.vertices[np.unique(layout.mesh.faces[layout.face_keys == drawer_key])]
+    assert (full[:, 1] > y_front + 0.1).any()  # the box reaches deep into the corpus before culling
+
+    out = generate_scene(tmp_path / "u", source="urdf", urdf_path=urdf_file, n_frames=4)
+    meta = json.loads((out / "synth_meta.json").read_text())
+    assert meta["culled_faces"] > 0 and meta["unobserved_parts"] == []
+    mesh = load_mesh(out / "scans" / "mesh_aligned_0.05.ply")
+    gt = read_articulate3d(out / "articulate3d")
+    drawer = next(p for p in gt.movable if p.articulation.joint_type == "prismatic")
+    v = mesh.vertices[drawer.vert_indices]
+    assert v[:, 1].max() < y_front + 1e-3  # nothing of the drawer left inside the corpus
+    front = v[v[:, 1] < y_front - 0.015]    # the front face (2 cm slab in front of the corpus)
+    assert np.ptp(front[:, 0]) == pytest.approx(0.58, abs=0.01) and np.ptp(front[:, 2]) == pytest.approx(0.3, abs=0.01)
 
 
 def test_bad_urdf_is_one_clear_error(tmp_path: Path) -> None:
