@@ -34,26 +34,35 @@ class HeuristicModel:
         self.scale = scale
         self.facets = planar_facets(self.mesh)
         self._cache: OrderedDict[str, tuple[np.ndarray, np.ndarray]] = OrderedDict()
-        visible = self._visible_facets(n_probe)
+        visible, glimpsed, view_dirs = self._visible_facets(n_probe)
         cams = np.array([f.c2w[:3, 3] for f in scene.frames])
-        self.fronts: list[Front] = find_fronts(self.mesh, self.facets, visible, cams.mean(0), rules)
+        self.fronts: list[Front] = find_fronts(self.mesh, self.facets, visible, cams.mean(0), rules, glimpsed, view_dirs)
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
         for i, fr in enumerate(self.fronts):
             self.face_front[fr.faces] = i
 
-    def _visible_facets(self, n_probe: int) -> np.ndarray:
+    def _visible_facets(self, n_probe: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per facet: clearly visible (>= 40 px over >= 2 probe views), glimpsed (any pixel), and the
+        pixel-weighted sum of unit directions towards the cameras that saw it (orients its normal)."""
         idx = np.unique(np.linspace(0, len(self.scene.frames) - 1, min(n_probe, len(self.scene.frames))).round().astype(int))
         px = np.zeros(self.facets.n, np.int64)
         seen = np.zeros(self.facets.n, np.int64)
+        dirs = np.zeros((self.facets.n, 3))
+        centroids = self.mesh.vertices[self.mesh.faces].mean(1)
         for i in idx:
             f = self.scene.frames[i]
             intr = f.intrinsics.scaled(max(1, f.intrinsics.width // 4), max(1, f.intrinsics.height // 4))
             ids = self.raster.render(intr.K, f.c2w, intr.width, intr.height).face_ids
-            lab = self.facets.labels[ids[ids >= 0]]
+            hit = ids[ids >= 0]
+            lab = self.facets.labels[hit]
             c = np.bincount(lab, minlength=self.facets.n)
             px += c
             seen += c >= 4
-        return (px >= 40) & (seen >= 2)
+            to_cam = f.c2w[:3, 3] - centroids[hit]
+            to_cam /= np.maximum(np.linalg.norm(to_cam, axis=1, keepdims=True), 1e-9)
+            for ax in range(3):
+                dirs[:, ax] += np.bincount(lab, weights=to_cam[:, ax], minlength=self.facets.n)
+        return (px >= 40) & (seen >= 2), px > 0, dirs
 
     def render(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
         """(front id, face id) images at the frame's RGB size; -1 = none."""

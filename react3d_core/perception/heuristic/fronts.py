@@ -33,6 +33,11 @@ class FrontRules:
     handle_depth: tuple[float, float] = (0.002, 0.09)  # handle facets in front of the plane (m)
     drawer_max_h: float = 0.42
     neighbour_gap: float = 0.03
+    frame_max_width: float = 0.2      # stiles/rails of a frame-and-panel front (m)
+    frame_depth: tuple[float, float] = (0.001, 0.03)  # frame pieces stand proud of a recessed panel ...
+    raised_depth: tuple[float, float] = (-0.016, -0.003)  # ... or a raised panel stands proud of them
+    rim_depth: float = 0.03           # edge/bevel facets of a front reach this far behind its plane
+    rim_margin: float = 0.02          # ... and this far outside its rectangle (chamfered edges)
 
 
 @dataclass
@@ -49,6 +54,7 @@ class Front:
     articulation: Articulation | None = None
     kind: str = ""
     faces: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    frame_facets: list[int] = field(default_factory=list)  # the other facets of a frame-and-panel front
 
     @property
     def w(self) -> float:
@@ -67,8 +73,13 @@ def _frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: np.ndarray,
-                rules: FrontRules = FrontRules()) -> list[Front]:
-    """Fronts among facets with ``visible[facet]`` True; ``cam_center`` orients normals to the room."""
+                rules: FrontRules = FrontRules(), glimpsed: np.ndarray | None = None,
+                view_dirs: np.ndarray | None = None) -> list[Front]:
+    """Fronts among facets with ``visible[facet]`` True.
+
+    Normals are oriented towards ``view_dirs[facet]`` (summed unit directions to the cameras that saw
+    it) where given, else towards ``cam_center``. ``glimpsed`` (default ``visible``): facets seen at
+    all, for a front's thin edges and bevels."""
     fv = mesh.vertices[mesh.faces]                       # (F,3,3)
     fc = fv.mean(1)
     order = np.argsort(facets.labels, kind="stable")
@@ -80,9 +91,11 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
     fcent = fa / np.maximum(facets.areas, 1e-15)[:, None]
 
     cands: list[Front] = []
+    rings: list[Front] = []  # door-sized outlines with holes: frames of frame-and-panel fronts
     for k in np.flatnonzero(visible & (np.abs(facets.normals[:, 2]) <= rules.max_tilt) & (facets.areas >= rules.min_w * rules.min_h)):
         n = facets.normals[k]
-        if np.dot(n, cam_center - fcent[k]) < 0:
+        toward = view_dirs[k] if view_dirs is not None and np.any(view_dirs[k]) else cam_center - fcent[k]
+        if np.dot(n, toward) < 0:
             n = -n
         nh, u = _frame(n)
         pts = fv[faces_of(k)].reshape(-1, 3)
@@ -92,13 +105,20 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
         if not (rules.min_w <= w <= rules.max_w and rules.min_h <= h <= rules.max_h):
             continue
         if facets.areas[k] < rules.min_fill * w * h:
+            if facets.areas[k] >= 0.15 * w * h:
+                rings.append(Front(int(k), [], fcent[k], nh, u, eu, ev))
             continue
         cands.append(Front(int(k), [], fcent[k], nh, u, eu, ev))
-    if not cands:
+    if not cands and not rings:
         return []
     cands = _drop_covered(cands)
+    _absorb_frames(cands, facets, fv, fcent, faces_of, visible, rules)
+    cands += _ring_fronts(cands, rings, facets, fv, fcent, faces_of, visible, rules)
     # handles: small visible facets just in front of a candidate, inside its rectangle (nearest plane wins)
-    small = np.flatnonzero(visible & (facets.areas <= rules.handle_max_area))
+    in_front = np.zeros(facets.n, bool)
+    for f in cands:
+        in_front[[f.facet, *f.frame_facets]] = True
+    small = np.flatnonzero(visible & (facets.areas <= rules.handle_max_area) & ~in_front)
     if len(small):
         c = fcent[small]                                                     # (S,3)
         centers = np.array([f.center for f in cands])                        # (C,3)
@@ -108,7 +128,8 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
         ev = np.array([f.extent_v for f in cands])
         d = np.einsum("scx,cx->sc", c[:, None, :] - centers[None], normals)   # depth in front of each plane
         cu, cv = c @ us.T, c[:, 2:3]
-        ok = ((rules.handle_depth[0] < d) & (d < rules.handle_depth[1])
+        facing = facets.normals[small] @ normals.T > -0.3  # a facet facing back at the front is another object's
+        ok = (facing & (rules.handle_depth[0] < d) & (d < rules.handle_depth[1])
               & (eu[:, 0] + 0.005 < cu) & (cu < eu[:, 1] - 0.005) & (ev[:, 0] + 0.005 < cv) & (cv < ev[:, 1] - 0.005))
         d = np.where(ok, d, np.inf)
         best = d.argmin(1)
@@ -120,11 +141,164 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
         if not f.handle_facets and not neighbours:
             continue  # a lone plain panel (a cabinet side, a wall piece): not openable by these rules
         hf = np.concatenate([faces_of(s) for s in f.handle_facets]) if f.handle_facets else np.zeros(0, np.int64)
-        f.faces = np.concatenate([faces_of(f.facet), hf])
+        f.faces = np.concatenate([faces_of(k) for k in [f.facet, *f.frame_facets]] + [hf])
         hpts = fv[hf].reshape(-1, 3) if len(hf) else None
         f.kind, f.articulation = _joint(f, hpts, neighbours, rules)
         out.append(f)
+    _add_rims(out, facets, fv, fcent, faces_of, visible if glimpsed is None else glimpsed, rules)
     return out
+
+
+def _facet_rect(pts: np.ndarray, f: Front) -> tuple[float, float, float, float]:
+    pu, pv = pts @ f.u, pts[:, 2]
+    return float(pu.min()), float(pu.max()), float(pv.min()), float(pv.max())
+
+
+def _absorb_frames(cands: list[Front], facets: Facets, fv: np.ndarray, fcent: np.ndarray, faces_of, visible: np.ndarray,  # noqa: ANN001
+                   r: FrontRules) -> None:
+    """Frame-and-panel fronts (shaker doors, oven doors around a window): grow a panel candidate by the
+    frame pieces around it — vertical facets facing the same way, a few mm to 3 cm in front of a
+    recessed panel or 3-16 mm behind a raised one (a carcass around an inset door is level with it, one
+    behind an overlay door ~2 cm behind it), touching the panel, within
+    ``frame_max_width`` of it, bordering at least three of its sides — when together they fill a
+    door/drawer-sized rectangle. A piece two panels claim goes to the one it touches more closely
+    (to neither on a tie: a face-frame rail between two doors)."""
+    if not cands:
+        return
+    taken = np.zeros(facets.n, bool)
+    taken[[f.facet for f in cands]] = True
+    vert = visible & (np.abs(facets.normals[:, 2]) <= r.max_tilt) & ~taken
+    m, t = r.frame_max_width, 0.015
+    plans: dict[int, list[tuple[int, float, float, float, float]]] = {}
+    claims: dict[int, list[tuple[float, int]]] = {}
+    for ci, f in enumerate(cands):
+        d = (fcent - f.center) @ f.n_out
+        cu, cv = fcent @ f.u, fcent[:, 2]
+        near = (vert & (np.abs(facets.normals @ f.n_out) >= 0.97) & (((d > r.frame_depth[0]) & (d < r.frame_depth[1])) | ((d > r.raised_depth[0]) & (d < r.raised_depth[1])))
+                & (cu > f.extent_u[0] - m) & (cu < f.extent_u[1] + m) & (cv > f.extent_v[0] - m) & (cv < f.extent_v[1] + m))
+        pieces = []
+        for k in np.flatnonzero(near):
+            u0, u1, v0, v1 = _facet_rect(fv[faces_of(k)].reshape(-1, 3), f)
+            inside = (u0 > f.extent_u[0] - m - 0.005 and u1 < f.extent_u[1] + m + 0.005
+                      and v0 > f.extent_v[0] - m - 0.005 and v1 < f.extent_v[1] + m + 0.005)
+            gap = max(u0 - f.extent_u[1], f.extent_u[0] - u1, v0 - f.extent_v[1], f.extent_v[0] - v1, 0.0)
+            if inside and gap <= t:
+                pieces.append((int(k), u0, u1, v0, v1))
+        if _frame_rect(f, pieces, facets, r) is None:
+            continue
+        plans[ci] = pieces
+        for p_ in pieces:
+            gap = max(p_[1] - f.extent_u[1], f.extent_u[0] - p_[2], p_[3] - f.extent_v[1], f.extent_v[0] - p_[4], 0.0)
+            claims.setdefault(p_[0], []).append((gap, ci))
+    owner = {}
+    for k, cl in claims.items():
+        cl.sort()
+        if len(cl) == 1 or cl[1][0] - cl[0][0] > 0.003:
+            owner[k] = cl[0][1]
+    for ci, pieces in plans.items():
+        pieces = [p_ for p_ in pieces if owner.get(p_[0]) == ci]
+        f = cands[ci]
+        rect = _frame_rect(f, pieces, facets, r)
+        if rect is None:
+            continue
+        (eu, ev), ks = rect, [p_[0] for p_ in pieces]
+        mid_u, mid_v = 0.5 * (eu[0] + eu[1]), 0.5 * (ev[0] + ev[1])
+        a = facets.areas[ks]
+        lift = max(0.0, float(((fcent[ks] - f.center) @ f.n_out * a).sum() / max(a.sum(), 1e-12)))  # plane of the frame
+        f.center = (f.center + f.u * (mid_u - float(f.center @ f.u)) + np.array([0.0, 0.0, mid_v - f.center[2]])
+                    + f.n_out * lift)
+        f.extent_u, f.extent_v, f.frame_facets = eu, ev, ks
+
+
+def _ring_fronts(cands: list[Front], rings: list[Front], facets: Facets, fv: np.ndarray, fcent: np.ndarray, faces_of,  # noqa: ANN001
+                 visible: np.ndarray, r: FrontRules) -> list[Front]:
+    """Frame-and-panel fronts whose panel is too small to be a front itself (a 13 cm drawer with an
+    8 cm panel): a ring-shaped facet whose hole is filled by free facets facing the same way — a
+    panel recessed behind it or raised in front of it — becomes a front."""
+    taken = np.zeros(facets.n, bool)
+    for f in cands:
+        taken[[f.facet, *f.frame_facets]] = True
+    out = []
+    for g in rings:
+        if taken[g.facet]:
+            continue
+        d = (fcent - g.center) @ g.n_out
+        cu, cv = fcent @ g.u, fcent[:, 2]
+        near = np.flatnonzero(visible & ~taken & (np.abs(facets.normals @ g.n_out) >= 0.97)
+                              & (((d > -r.frame_depth[1]) & (d < -r.frame_depth[0])) | ((d > -r.raised_depth[1]) & (d < -r.raised_depth[0])))
+                              & (cu > g.extent_u[0]) & (cu < g.extent_u[1]) & (cv > g.extent_v[0]) & (cv < g.extent_v[1]))
+        ks = []
+        for k in near:
+            u0, u1, v0, v1 = _facet_rect(fv[faces_of(k)].reshape(-1, 3), g)
+            if u0 > g.extent_u[0] - 0.005 and u1 < g.extent_u[1] + 0.005 and v0 > g.extent_v[0] - 0.005 and v1 < g.extent_v[1] + 0.005:
+                ks.append(int(k))
+        if ks and facets.areas[g.facet] + facets.areas[ks].sum() >= r.min_fill * g.w * g.h:
+            g.frame_facets = ks
+            taken[[g.facet, *ks]] = True
+            out.append(g)
+    return out
+
+
+def _frame_rect(f: Front, pieces: list[tuple[int, float, float, float, float]], facets: Facets,
+                r: FrontRules) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """Outer rectangle of panel + frame pieces when they form a frame-and-panel front, else None."""
+    if len(_sides(f, pieces)) < 3:
+        return None  # a frame surrounds its panel; a single rail next to a front is the carcass
+    eu = (min([f.extent_u[0]] + [p[1] for p in pieces]), max([f.extent_u[1]] + [p[2] for p in pieces]))
+    ev = (min([f.extent_v[0]] + [p[3] for p in pieces]), max([f.extent_v[1]] + [p[4] for p in pieces]))
+    w, h = eu[1] - eu[0], ev[1] - ev[0]
+    area = facets.areas[f.facet] + sum(facets.areas[p[0]] for p in pieces)
+    if not (r.min_w <= w <= r.max_w and r.min_h <= h <= r.max_h) or area < r.min_fill * w * h:
+        return None
+    if facets.areas[f.facet] > 0.85 * w * h:
+        return None  # only slivers around a plain front: nothing to absorb
+    return eu, ev
+
+
+def _sides(f: Front, pieces: list[tuple[int, float, float, float, float]]) -> set[str]:
+    """Which sides of ``f`` the pieces border (beyond the edge, overlapping it by half its length)."""
+    out = set()
+    (a0, a1), (b0, b1) = f.extent_u, f.extent_v
+    for _, u0, u1, v0, v1 in pieces:
+        ov_v = min(v1, b1) - max(v0, b0) >= 0.5 * (b1 - b0)
+        ov_u = min(u1, a1) - max(u0, a0) >= 0.5 * (a1 - a0)
+        out |= {s for s, ok in (("left", u0 < a0 - 0.005 and ov_v), ("right", u1 > a1 + 0.005 and ov_v),
+                                ("bottom", v0 < b0 - 0.005 and ov_u), ("top", v1 > b1 + 0.005 and ov_u)) if ok}
+    return out
+
+
+def _add_rims(fronts: list[Front], facets: Facets, fv: np.ndarray, fcent: np.ndarray, faces_of, glimpsed: np.ndarray,  # noqa: ANN001
+              r: FrontRules) -> None:
+    """Add a front's own edges and bevels: small facets glimpsed by the cameras that lie inside its
+    rectangle (± ``rim_margin``) between ``rim_depth`` behind its plane and 1 cm in front, not part of
+    another front; a facet that fits several fronts goes to the one whose rectangle holds its centre deepest."""
+    if not fronts:
+        return
+    used = np.zeros(facets.n, bool)
+    for f in fronts:
+        used[[f.facet, *f.frame_facets, *f.handle_facets]] = True
+    free = np.flatnonzero(glimpsed & ~used & (facets.areas <= r.handle_max_area))
+    if not len(free):
+        return
+    m = r.rim_margin
+    best = np.full(len(free), -np.inf)
+    owner = np.full(len(free), -1)
+    for i, f in enumerate(fronts):
+        d = (fcent[free] - f.center) @ f.n_out
+        cu, cv = fcent[free] @ f.u, fcent[free, 2]
+        inset = np.minimum.reduce([cu - f.extent_u[0], f.extent_u[1] - cu, cv - f.extent_v[0], f.extent_v[1] - cv])
+        cand = np.flatnonzero((d > -r.rim_depth) & (d < 0.01) & (inset > -m) & (inset > best))
+        for j in cand:
+            pts = fv[faces_of(free[j])].reshape(-1, 3)
+            u0, u1, v0, v1 = _facet_rect(pts, f)
+            dd = (pts - f.center) @ f.n_out
+            if (u0 > f.extent_u[0] - m and u1 < f.extent_u[1] + m and v0 > f.extent_v[0] - m
+                    and v1 < f.extent_v[1] + m and dd.min() > -r.rim_depth and dd.max() < 0.01):
+                best[j], owner[j] = inset[j], i
+    for i, f in enumerate(fronts):
+        ks = free[owner == i]
+        if len(ks):
+            f.faces = np.concatenate([f.faces, *[faces_of(k) for k in ks]])
 
 
 def _drop_covered(cands: list[Front]) -> list[Front]:

@@ -119,3 +119,57 @@ def test_low_square_handleless_front_under_a_door_is_a_drawer() -> None:
     fronts = find_fronts(mesh, facets, _visible(mesh, facets), np.array([0.2, -2.0, 1.2]))
     kinds = sorted((round(float(f.center[2]), 1), f.kind) for f in fronts)
     assert [k for _, k in kinds] == ["drawer", "door"]
+
+
+def _shaker_cabinet(raised: bool) -> TriMesh:
+    """Two 0.498 x 0.7 m frame-and-panel doors side by side (7 cm stiles/rails, a 0.36 x 0.56 panel 8 mm
+    behind the frame, or 8 mm proud of it when ``raised``), vertical handles on the inner stiles."""
+    m = MeshBuilder(edge=0.05)
+    m.add_box([0, 0.0, 0], [1.004, 0.6, 0.72], (200, 200, 200))                  # carcass block
+    py = (-0.028, -0.001) if raised else (-0.012, -0.001)                         # panel front at -0.028 / -0.012
+    for x0 in (0.002, 0.504):  # 2 mm gap between the doors
+        x1 = x0 + 0.498
+        for lo, hi in (([x0, -0.02, 0.01], [x0 + 0.07, -0.001, 0.71]),           # stiles and rails (front y = -0.02)
+                       ([x1 - 0.07, -0.02, 0.01], [x1, -0.001, 0.71]),
+                       ([x0 + 0.07, -0.02, 0.01], [x1 - 0.07, -0.001, 0.08]),
+                       ([x0 + 0.07, -0.02, 0.64], [x1 - 0.07, -0.001, 0.71])):
+            m.add_box(lo, hi, (150, 100, 80))
+        m.add_box([x0 + 0.07, py[0], 0.08], [x1 - 0.07, py[1], 0.64], (150, 100, 80))  # panel
+    m.add_box([0.46, -0.05, 0.3], [0.475, -0.02, 0.45], (30, 30, 30))            # left door handle (right stile)
+    m.add_box([0.531, -0.05, 0.3], [0.546, -0.02, 0.45], (30, 30, 30))           # right door handle (left stile)
+    mesh, _, _ = m.build()
+    return mesh
+
+
+@pytest.mark.parametrize("raised", [False, True])
+def test_frame_and_panel_doors_are_whole_fronts(raised: bool) -> None:
+    """A shaker door is a panel plus the stiles/rails around it: the front spans the outer 0.5 x 0.7 m
+    rectangle, holds the frame's faces and hinges opposite its handle; no rail goes to the neighbour."""
+    mesh = _shaker_cabinet(raised)
+    facets = planar_facets(mesh)
+    fronts = sorted(find_fronts(mesh, facets, _visible(mesh, facets), np.array([0.5, -2.0, 1.2])), key=lambda f: f.center[0])
+    assert len(fronts) == 2
+    for f, x0, hinge_x in zip(fronts, (0.002, 0.504), (0.002, 1.002)):
+        assert f.w == pytest.approx(0.498, abs=0.005) and f.h == pytest.approx(0.7, abs=0.005)
+        assert f.extent_v[0] == pytest.approx(0.01, abs=0.005)
+        c = mesh.vertices[mesh.faces[f.faces]].mean(1)
+        front_faces = c[c[:, 1] < -0.0015]
+        assert front_faces[:, 0].min() < x0 + 0.07 and front_faces[:, 0].max() > x0 + 0.43  # stiles included
+        assert ((front_faces[:, 0] > x0 - 0.001) & (front_faces[:, 0] < x0 + 0.499)).all()   # nothing of the neighbour
+        a = f.articulation
+        assert f.kind == "door" and a.origin[0] == pytest.approx(hinge_x, abs=0.006)
+
+
+def test_level_carcass_around_an_inset_front_is_not_absorbed() -> None:
+    """An inset door flush with the carcass face around it (dishwasher-like): the carcass stays out."""
+    m = MeshBuilder(edge=0.05)
+    m.add_box([0, 0.0, 0], [0.7, 0.6, 0.85], (200, 200, 200))
+    m.add_box([0.0, -0.02, 0.0], [0.7, -0.001, 0.05], (200, 200, 200))     # kick plate, level with the door
+    m.add_box([0.0, -0.02, 0.75], [0.7, -0.001, 0.85], (200, 200, 200))    # control strip, level
+    m.add_box([0.0, -0.02, 0.053], [0.7, -0.001, 0.747], (150, 100, 80))   # the door
+    m.add_box([0.2, -0.05, 0.68], [0.5, -0.02, 0.695], (30, 30, 30))       # horizontal handle, high
+    mesh, _, _ = m.build()
+    facets = planar_facets(mesh)
+    fronts = find_fronts(mesh, facets, _visible(mesh, facets), np.array([0.35, -2.0, 1.2]))
+    assert len(fronts) == 1 and fronts[0].h == pytest.approx(0.694, abs=0.005) and not fronts[0].frame_facets
+    assert fronts[0].kind == "drop"
