@@ -41,6 +41,7 @@ class DedupConfig(StageConfig):
     tau_low: float = Field(0.2, ge=0, le=1, description="Stage 2: smaller parts with IoU >= this are cover candidates.")
     cover_iou: float = Field(0.8, ge=0, le=1, description="Stage 2: remove a part whose candidates' union reaches this IoU.")
     max_candidates: int = Field(16, ge=1, description="Stage 2 bound: consider at most this many candidates per part.")
+    tau_contained: float = Field(0.7, ge=0, le=1, description="Stage 3: remove a part with this share of its vertices inside one larger kept part (a fragment).")
 
 
 class AssemblyConfig(StageConfig):

@@ -5,6 +5,9 @@ Stage 2: a part covered by a union of smaller parts (each with IoU >= tau_low ag
 IoU >= cover_iou is removed (it merged several fronts). The reference enumerated every subset of the
 smaller parts (2^n); here a greedy cover over at most ``max_candidates`` parts, largest overlap first,
 is O(n * k). Overlaps come from one sparse incidence product, not Python pairs.
+Stage 3 (ours): a fragment — a part with >= tau_contained of its vertices inside one larger kept part —
+is removed. Distinct physical parts share at most boundary vertices, so such a part is a piece of the
+larger one (a frame or a panel of a frame-and-panel door that fusion also proposed on its own).
 """
 
 from __future__ import annotations
@@ -17,7 +20,7 @@ from scipy.sparse import csr_matrix
 
 from ..config import DedupConfig
 
-STAGE_VERSION = "1"
+STAGE_VERSION = "2"  # 2: stage 3 removes fragments
 T = TypeVar("T")
 
 
@@ -66,6 +69,11 @@ def dedup_indices(sets: Sequence[np.ndarray], cfg: DedupConfig) -> list[int]:
             if iou_new > best:
                 cover, best = new, iou_new
         if best >= cfg.cover_iou:
+            alive[i] = False
+    contained = inter / np.maximum(size[:, None], 1e-12)  # [i, j] = share of part i inside part j
+    for i in order[::-1]:  # stage 3, smaller first
+        inside = alive & (size > size[i]) & (contained[i] >= cfg.tau_contained)
+        if alive[i] and inside.any():
             alive[i] = False
     return [int(i) for i in np.flatnonzero(alive)]
 

@@ -66,8 +66,20 @@ def test_dedup_stage2_removes_a_merged_part() -> None:
     merged = np.arange(0, 100)        # IoU 0.5 with each half: stage 1 keeps all (tau_dup = 0.5 needs >=)
     keep = dedup_indices([merged, left, right], DedupConfig(tau_dup=0.6))
     assert keep == [1, 2]              # the union of the halves covers the merged part with IoU 1.0
-    # a single half does not cover it (IoU 0.5 < 0.8): nothing removed in stage 2
-    assert dedup_indices([merged, left], DedupConfig(tau_dup=0.6)) == [0, 1]
+    # a single half does not cover it (IoU 0.5 < 0.8): stage 2 keeps the merged part, and stage 3 then
+    # drops the half as a fragment of it (100 % of its vertices inside)
+    assert dedup_indices([merged, left], DedupConfig(tau_dup=0.6)) == [0]
+
+
+def test_dedup_stage3_removes_fragments_keeps_neighbours() -> None:
+    door = np.arange(0, 500)
+    panel = np.arange(100, 250)                      # 150 vertices, all inside the door: a fragment
+    sliver = np.concatenate([np.arange(490, 500), np.arange(1000, 1030)])  # 10 of 40 inside (25 %)
+    neighbour = np.arange(480, 900)                  # shares a 20-vertex boundary strip with the door
+    keep = dedup_indices([door, panel, sliver, neighbour], DedupConfig())
+    assert keep == [0, 2, 3]
+    # at 0.2 the sliver (25 % inside the door, 10 / 40 inside the neighbour too) goes as well
+    assert dedup_indices([door, panel, sliver, neighbour], DedupConfig(tau_contained=0.2)) == [0, 3]
 
 
 def test_dedup_is_bounded_on_many_overlapping_candidates() -> None:
