@@ -16,7 +16,7 @@ from .backend import (HeuristicArticulation, HeuristicModel, HeuristicPointSegme
                       HeuristicTagger, KeepOpenable)
 from .fronts import FrontRules
 
-STAGE_VERSION = "1"
+STAGE_VERSION = "2"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45
 
 
 def make_heuristic(scene: SceneInput, config: PerceptionConfig) -> Perception:

@@ -31,7 +31,7 @@ class FrontRules:
     min_fill: float = 0.8             # facet area / bounding rectangle
     handle_max_area: float = 0.03     # m^2 of one handle facet
     handle_depth: tuple[float, float] = (0.002, 0.09)  # handle facets in front of the plane (m)
-    drawer_max_h: float = 0.42
+    drawer_max_h: float = 0.45          # deep drawers reach ~0.45 m; oven/dishwasher doors are >= 0.5 m
     neighbour_gap: float = 0.03
     frame_max_width: float = 0.2      # stiles/rails of a frame-and-panel front (m)
     frame_depth: tuple[float, float] = (0.001, 0.03)  # frame pieces stand proud of a recessed panel ...
