@@ -150,8 +150,22 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
 
 
 def _facet_rect(pts: np.ndarray, f: Front) -> tuple[float, float, float, float]:
+    """(u0, u1, v0, v1) of points in ``f``'s frame."""
     pu, pv = pts @ f.u, pts[:, 2]
     return float(pu.min()), float(pu.max()), float(pv.min()), float(pv.max())
+
+
+def _within(f: Front, rect: tuple[float, float, float, float], margin: float) -> bool:
+    """``rect`` lies inside ``f``'s rectangle grown by ``margin``."""
+    u0, u1, v0, v1 = rect
+    return (u0 > f.extent_u[0] - margin and u1 < f.extent_u[1] + margin
+            and v0 > f.extent_v[0] - margin and v1 < f.extent_v[1] + margin)
+
+
+def _gap(f: Front, rect: tuple[float, float, float, float]) -> float:
+    """Distance from ``rect`` to ``f``'s rectangle (0 when they touch or overlap)."""
+    u0, u1, v0, v1 = rect
+    return max(u0 - f.extent_u[1], f.extent_u[0] - u1, v0 - f.extent_v[1], f.extent_v[0] - v1, 0.0)
 
 
 def _absorb_frames(cands: list[Front], facets: Facets, fv: np.ndarray, fcent: np.ndarray, faces_of, visible: np.ndarray,  # noqa: ANN001
@@ -178,18 +192,14 @@ def _absorb_frames(cands: list[Front], facets: Facets, fv: np.ndarray, fcent: np
                 & (cu > f.extent_u[0] - m) & (cu < f.extent_u[1] + m) & (cv > f.extent_v[0] - m) & (cv < f.extent_v[1] + m))
         pieces = []
         for k in np.flatnonzero(near):
-            u0, u1, v0, v1 = _facet_rect(fv[faces_of(k)].reshape(-1, 3), f)
-            inside = (u0 > f.extent_u[0] - m - 0.005 and u1 < f.extent_u[1] + m + 0.005
-                      and v0 > f.extent_v[0] - m - 0.005 and v1 < f.extent_v[1] + m + 0.005)
-            gap = max(u0 - f.extent_u[1], f.extent_u[0] - u1, v0 - f.extent_v[1], f.extent_v[0] - v1, 0.0)
-            if inside and gap <= t:
-                pieces.append((int(k), u0, u1, v0, v1))
+            rect = _facet_rect(fv[faces_of(k)].reshape(-1, 3), f)
+            if _within(f, rect, m + 0.005) and _gap(f, rect) <= t:
+                pieces.append((int(k), *rect))
         if _frame_rect(f, pieces, facets, r) is None:
             continue
         plans[ci] = pieces
         for p_ in pieces:
-            gap = max(p_[1] - f.extent_u[1], f.extent_u[0] - p_[2], p_[3] - f.extent_v[1], f.extent_v[0] - p_[4], 0.0)
-            claims.setdefault(p_[0], []).append((gap, ci))
+            claims.setdefault(p_[0], []).append((_gap(f, p_[1:]), ci))
     owner = {}
     for k, cl in claims.items():
         cl.sort()
@@ -229,8 +239,7 @@ def _ring_fronts(cands: list[Front], rings: list[Front], facets: Facets, fv: np.
                               & (cu > g.extent_u[0]) & (cu < g.extent_u[1]) & (cv > g.extent_v[0]) & (cv < g.extent_v[1]))
         ks = []
         for k in near:
-            u0, u1, v0, v1 = _facet_rect(fv[faces_of(k)].reshape(-1, 3), g)
-            if u0 > g.extent_u[0] - 0.005 and u1 < g.extent_u[1] + 0.005 and v0 > g.extent_v[0] - 0.005 and v1 < g.extent_v[1] + 0.005:
+            if _within(g, _facet_rect(fv[faces_of(k)].reshape(-1, 3), g), 0.005):
                 ks.append(int(k))
         if ks and facets.areas[g.facet] + facets.areas[ks].sum() >= r.min_fill * g.w * g.h:
             g.frame_facets = ks
@@ -290,10 +299,8 @@ def _add_rims(fronts: list[Front], facets: Facets, fv: np.ndarray, fcent: np.nda
         cand = np.flatnonzero((d > -r.rim_depth) & (d < 0.01) & (inset > -m) & (inset > best))
         for j in cand:
             pts = fv[faces_of(free[j])].reshape(-1, 3)
-            u0, u1, v0, v1 = _facet_rect(pts, f)
             dd = (pts - f.center) @ f.n_out
-            if (u0 > f.extent_u[0] - m and u1 < f.extent_u[1] + m and v0 > f.extent_v[0] - m
-                    and v1 < f.extent_v[1] + m and dd.min() > -r.rim_depth and dd.max() < 0.01):
+            if _within(f, _facet_rect(pts, f), m) and dd.min() > -r.rim_depth and dd.max() < 0.01:
                 best[j], owner[j] = inset[j], i
     for i, f in enumerate(fronts):
         ks = free[owner == i]
