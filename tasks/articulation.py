@@ -25,6 +25,8 @@ def articulate_body(scene_path: str, frames_cfg: dict[str, Any], candidates: dic
     views = {v.frame_id for v in cand.top_views}
     preds: dict[str, list] = {}
     for h in perception:
+        if "frame_ids" in h and views.isdisjoint(h["frame_ids"]):
+            continue  # none of this candidate's views: don't decode the batch
         for fid, p in get(h)["predictions"].items():
             if fid in views:
                 preds[fid] = p

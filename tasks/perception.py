@@ -88,6 +88,7 @@ def perceive_body(scene_path: str, frames_cfg: dict[str, Any], frame_ids: list[s
     h = put(result, "perception")
     h["seconds"] = time.perf_counter() - t0
     h["n_masks"] = sum(len(m) for m in masks)
+    h["frame_ids"] = list(frame_ids)  # lets per-part tasks open only the batches holding their views
     return h
 
 

@@ -8,6 +8,7 @@ from typing import Any
 from prefect import task
 
 from react3d_core.config import PipelineConfig
+from react3d_core.data.masks import PackedMasks
 
 from .keys import content_key
 from .perception import get_perception
@@ -21,9 +22,10 @@ def segment_body(scene_path: str, frames_cfg: dict[str, Any], perception: list[d
     t0 = time.perf_counter()
     cfg = PipelineConfig().with_overrides(config)
     scene = scene_input(scene_path, frames_cfg)
-    masks: dict[str, list] = {}
+    masks = PackedMasks()  # bit-packed: a long capture's masks stay small (issue: memory grew per frame)
     for h in perception:
-        masks.update(get(h)["masks"])
+        for fid, ms in get(h, cache=False)["masks"].items():
+            masks.add(fid, ms)
     perc = get_perception(scene, cfg.perception)
     mesh_path = str(scene.mesh_path)
     cands = segment_parts(scene, scan_mesh(mesh_path), masks, perc.point_segmenter, cfg, rasterizer=rasterizer(mesh_path))

@@ -36,15 +36,18 @@ def put(obj: Any, kind: str) -> dict[str, str]:
     return {"sha256": sha, "path": str(path), "kind": kind}
 
 
-def get(handle: dict[str, str]) -> Any:
+def get(handle: dict[str, str], cache: bool = True) -> Any:
     """Load the object behind a handle (clear error if the store was cleaned under a cached record).
 
     The last few decoded objects are kept per process: per-part tasks read the same perception results.
+    ``cache=False`` decodes without keeping it (a fan-in that reads every batch once).
     """
     path = Path(handle["path"])
     if not path.is_file():
         raise InputError(path, f"cached {handle.get('kind', 'result')} is gone from the store; "
                                "run `react3d cache clean` (drops stale records) and convert again")
+    if not cache:
+        return loads(path.read_bytes())
     return _get_cached(handle["sha256"], str(path))
 
 

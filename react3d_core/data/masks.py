@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Literal
 
@@ -90,3 +90,55 @@ def load_masks(path: str | Path) -> list[Mask2D]:
         return out
     except KeyError as exc:
         raise InputError(path, f"mask archive lacks field {exc}") from None
+
+
+_Packed = tuple[bytes, tuple[int, int], str, str, float, "tuple | None"]
+
+
+class _PackedFrame(Sequence[Mask2D]):
+    """One frame's packed masks; each is unpacked only when indexed (top-k views read one or two)."""
+
+    def __init__(self, packed: list[_Packed]) -> None:
+        self._packed = packed
+
+    def __len__(self) -> int:
+        return len(self._packed)
+
+    def __getitem__(self, i):  # noqa: ANN001, ANN204 - Sequence protocol (int or slice)
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        bits, (h, w), fid, label, score, box = self._packed[i]
+        mask = np.unpackbits(np.frombuffer(bits, np.uint8), count=h * w).astype(bool).reshape(h, w)
+        return Mask2D(frame_id=fid, label=label, score=score, mask=mask, box=box)
+
+
+class PackedMasks(Mapping[str, Sequence[Mask2D]]):
+    """Frame id -> masks, held bit-packed (1 bit per pixel) and unpacked on access.
+
+    Fusion reads every frame's masks once to lift them and a few again for the top-k views, so a
+    scene's masks need not sit unpacked in memory: a 960x720 mask is 691 kB as bools, 86 kB packed.
+    """
+
+    def __init__(self) -> None:
+        self._frames: dict[str, list[_Packed]] = {}
+
+    def add(self, frame_id: str, masks: Sequence[Mask2D]) -> None:
+        """Store (replace) one frame's masks, packed."""
+        self._frames[frame_id] = [
+            (np.packbits(m.mask.astype(bool).ravel()).tobytes(), tuple(m.mask.shape), m.frame_id, m.label,
+             float(m.score), m.box) for m in masks]
+
+    def __getitem__(self, frame_id: str) -> Sequence[Mask2D]:
+        return _PackedFrame(self._frames[frame_id])
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._frames)
+
+    def __len__(self) -> int:
+        return len(self._frames)
+
+    @property
+    def nbytes(self) -> int:
+        """Bytes held by the packed masks."""
+        return sum(len(m[0]) for ms in self._frames.values() for m in ms)
+

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from react3d_core.data.frames import validate_pose
-from react3d_core.data.masks import Mask2D, load_masks, save_masks
+from react3d_core.data.masks import Mask2D, PackedMasks, load_masks, save_masks
 from react3d_core.data.parts import Articulation
 from react3d_core.ground_truth.articulate3d import GroundTruth, GTPart, read_articulate3d, write_articulate3d
 
@@ -37,6 +37,25 @@ def test_masks_roundtrip(tmp_path: Path) -> None:
     back = load_masks(save_masks(tmp_path / "m.npz", ms))
     assert [(m.frame_id, m.label, m.score, m.box) for m in back] == [(m.frame_id, m.label, m.score, m.box) for m in ms]
     assert all(np.array_equal(a.mask, b.mask) for a, b in zip(ms, back))
+
+
+def test_packed_masks_unpack_on_access() -> None:
+    rng = np.random.default_rng(0)
+    a = [Mask2D(frame_id="f0", label="door", score=0.5, mask=rng.random((5, 11)) > 0.5, box=(1.0, 2.0, 3.0, 4.0)),
+         Mask2D(frame_id="f0", mask=np.zeros((5, 11), bool))]
+    pm = PackedMasks()
+    pm.add("f0", a)
+    pm.add("f1", [])
+    assert list(pm) == ["f0", "f1"] and len(pm) == 2 and pm.get("f2") is None
+    assert pm.nbytes == 2 * 7  # 55 bits -> 7 bytes per mask
+    got = pm["f0"]
+    assert len(got) == 2 and len(pm["f1"]) == 0
+    for m, g in zip(a, [got[0], got[-1]]):
+        assert g.mask.dtype == bool and np.array_equal(g.mask, m.mask)
+        assert (g.frame_id, g.label, g.score, g.box) == (m.frame_id, m.label, m.score, m.box)
+    assert [np.array_equal(g.mask, m.mask) for g, m in zip(got[0:2], a)] == [True, True]
+    with pytest.raises(IndexError):
+        got[2]
 
 
 def test_articulate3d_roundtrip(tmp_path: Path) -> None:
