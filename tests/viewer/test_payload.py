@@ -38,6 +38,27 @@ def test_decimate_respects_budget(toy_scene):
     assert d.n_faces <= 500 and d.colors.shape == (d.n_vertices, 3)
 
 
+def test_decimate_keeps_the_surface_and_its_colours():
+    # a 1 m x 1 m grid of 20k faces, red left half / blue right half, bent 90 degrees at y = 0.5
+    n = 101
+    u, v = np.meshgrid(np.linspace(0, 1, n), np.linspace(0, 1, n), indexing="ij")
+    u, v = u.ravel(), v.ravel()
+    pts = np.stack([u, np.minimum(v, 0.5), np.maximum(v - 0.5, 0.0)], 1)
+    i = np.arange(n - 1)[:, None] * n + np.arange(n - 1)[None, :]
+    i = i.ravel()
+    faces = np.concatenate([np.stack([i, i + n, i + 1], 1), np.stack([i + 1, i + n, i + n + 1], 1)])
+    cols = np.where((u < 0.5)[:, None], [[255, 0, 0]], [[0, 0, 255]]).astype(np.uint8)
+    m = TriMesh(pts, faces, cols)
+    d = decimate(m, 2000)
+    assert 1500 <= d.n_faces <= 2000
+    assert np.allclose(d.bounds(), m.bounds(), atol=1e-3)  # corners survive
+    on_plane = np.minimum(np.abs(d.vertices[:, 2]), np.abs(d.vertices[:, 1] - 0.5))
+    assert on_plane.max() < 1e-3  # every vertex stays on one of the two planes
+    far = np.abs(d.vertices[:, 0] - 0.5) > 0.02
+    red = d.vertices[far, 0] < 0.5
+    assert (d.colors[far][red] == [255, 0, 0]).all() and (d.colors[far][~red] == [0, 0, 255]).all()
+
+
 def test_report_is_self_contained(toy_scene, tmp_path):
     out = write_report(toy_scene, tmp_path / "report.html", metrics={"0.25": {"f1": 0.5, "precision": 1.0}})
     html = out.read_text()
