@@ -44,7 +44,9 @@ def measure(scene_dir: Path, res_dir: Path, config: dict[str, Any], frames: int,
 
     ctx = mp.get_context("spawn")
     with ctx.Pool(1, maxtasksperchild=1) as pool:
-        r = pool.apply(run_one, ({"name": scene_dir.name, "scene_dir": str(scene_dir)}, str(res_dir), config))
+        # cold: an earlier run of the same scene (same content keys) must not turn this into a cache hit
+        r = pool.apply(run_one, ({"name": scene_dir.name, "scene_dir": str(scene_dir)}, str(res_dir), config,
+                                 str(res_dir.parent / "cold-cache")))
     timings = InteractiveScene.load(r["manifest"]).timings
     return {"frames": frames, "faces": faces, "wall_s": r["wall_s"], "peak_rss_mb": r["peak_rss_mb"], "stages": timings}
 

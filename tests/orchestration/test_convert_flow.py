@@ -113,3 +113,21 @@ def test_dataset_run_isolates_a_corrupt_scene(scene: Path, tmp_path: Path) -> No
     by = {r["scene"]: r for r in rows}
     assert by["good"]["status"] == "ok" and by["good"]["parts"] > 0
     assert by["broken"]["status"] == "failed" and "mesh_aligned_0.05.ply" in by["broken"]["error"]
+
+
+def test_cold_cache_recomputes_and_leaves_a_self_contained_result(scene: Path, tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
+    from flows.commands.bench import cold_cache
+    from tasks.store import cache_root
+
+    cfg = {**CFG, "perception": {"backend": "oracle", "oracle": {"seed": 14}}, "export": {"formats": []}}
+    convert_scene(str(scene), str(tmp_path / "warm"), cfg)
+    warm_store = cache_root()
+    counts = [_counting(monkeypatch, mod, fn) for mod, fn in ((t_perc, "perceive_body"), (t_seg, "segment_body"))]
+    with cold_cache(tmp_path / "cold") as root:
+        assert cache_root() == root / "react3d"
+        manifest = convert_scene(str(scene), str(tmp_path / "out"), cfg)
+        assert any((root / "react3d" / "objects").rglob("*.npz"))
+    assert [len(c) for c in counts] == [2, 1]  # 16 frames = 2 batches: a warm cache held them; the cold run recomputed
+    assert not (tmp_path / "cold").exists() and cache_root() == warm_store
+    m = InteractiveScene.load(manifest)  # the published result does not point into the deleted cache
+    assert m.objects and all((Path(manifest).parent / o.part_mesh).is_file() for o in m.objects)
