@@ -12,7 +12,6 @@ Writes <out>/scaling.json and <out>/scaling.png.
 from __future__ import annotations
 
 import argparse
-import multiprocessing as mp
 import shutil
 import sys
 from pathlib import Path
@@ -20,7 +19,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from flows.commands.bench import run_one  # noqa: E402
+from flows.commands.bench import run_isolated, run_one  # noqa: E402
 from react3d_core.atomic import atomic_path, write_json  # noqa: E402
 
 
@@ -42,11 +41,9 @@ def densify(scene_dir: Path, target_faces: int) -> int:
 def measure(scene_dir: Path, res_dir: Path, config: dict[str, Any], frames: int, faces: int | None) -> dict[str, Any]:
     from react3d_core.data.parts import InteractiveScene
 
-    ctx = mp.get_context("spawn")
-    with ctx.Pool(1, maxtasksperchild=1) as pool:
-        # cold: an earlier run of the same scene (same content keys) must not turn this into a cache hit
-        r = pool.apply(run_one, ({"name": scene_dir.name, "scene_dir": str(scene_dir)}, str(res_dir), config,
-                                 str(res_dir.parent / "cold-cache")))
+    # cold: an earlier run of the same scene (same content keys) must not turn this into a cache hit
+    r = run_isolated(run_one, {"name": scene_dir.name, "scene_dir": str(scene_dir)}, str(res_dir), config,
+                     str(res_dir.parent / "cold-cache"))
     timings = InteractiveScene.load(r["manifest"]).timings
     return {"frames": frames, "faces": faces, "wall_s": r["wall_s"], "peak_rss_mb": r["peak_rss_mb"], "stages": timings}
 

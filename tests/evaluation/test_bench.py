@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flows.commands.bench import SETS_DIR, load_spec, print_table, run_bench
+from flows.commands.bench import SETS_DIR, load_spec, print_table, run_bench, run_isolated
 from react3d_core.data.mesh import TriMesh, load_mesh, save_mesh
 from react3d_core.errors import InputError
 
@@ -69,3 +69,27 @@ def test_smoke_set_end_to_end(tmp_path):
     res = run_bench(load_spec("smoke", tmp_path, frames=20), tmp_path, {"perception": {"backend": "oracle"}})
     assert not res["failed"], res["failed"]
     assert res["aggregate"]["0.25"]["f1"] is not None
+
+
+def _start_prefect_server() -> int:
+    """What a converted scene does in a benchmark child: start Prefect's temporary server, whose stop is an
+    atexit hook; Prefect's services register later hooks that run first and take a while (simulated)."""
+    import atexit
+    import time
+
+    from prefect.server.api.server import SubprocessASGIServer
+
+    s = SubprocessASGIServer()
+    s.start()
+    atexit.register(time.sleep, 3)
+    return s.server_process.pid
+
+
+def test_isolated_run_leaves_no_prefect_server_behind():
+    import psutil
+
+    pid = run_isolated(_start_prefect_server)
+    alive = psutil.pid_exists(pid) and psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
+    if alive:
+        psutil.Process(pid).kill()
+    assert not alive, "the benchmark child left its Prefect server running"
