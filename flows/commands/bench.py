@@ -15,7 +15,7 @@ import resource
 import shutil
 import time
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
+from contextlib import contextmanager, nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -107,16 +107,11 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
     from flows.convert_scene import convert_scene
 
     rss0 = _peak_rss_mb()
-    with cold_cache(cold) if cold else _nothing():
+    with cold_cache(cold) if cold else nullcontext():
         t0 = time.perf_counter()
         manifest = convert_scene(str(scene_dir), result_dir, config)
         wall = time.perf_counter() - t0
     return {"manifest": str(manifest), "wall_s": wall, "peak_rss_mb": _peak_rss_mb(), "rss_before_mb": rss0}
-
-
-@contextmanager
-def _nothing() -> Iterator[None]:
-    yield None
 
 
 def _stopping_server(fn: Callable[..., Any], *args: Any) -> Any:
