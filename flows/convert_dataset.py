@@ -19,6 +19,10 @@ prefect_env.configure()
 
 from prefect import flow  # noqa: E402
 
+from react3d_core.atomic import check_output_dir  # noqa: E402
+from react3d_core.errors import InputError  # noqa: E402
+from tasks.assembly import OUTPUT_KIND  # noqa: E402
+
 from .convert_scene import convert_scene  # noqa: E402
 
 
@@ -35,6 +39,26 @@ def find_scenes(root: str | Path, scene_ids: list[str] | None = None, glob: str 
         if glob or any((d / n).exists() for n in ("scans", "iphone", "dslr", "mesh_aligned_0.05.ply", "transforms.json")):
             found.append(d)
     return found
+
+
+def check_dataset_outputs(root: str | Path, scene_ids: list[str] | None, glob: str | None,
+                          out_root: str | Path) -> list[Path]:
+    """Refuse the whole run before any scene starts when one scene's output folder is unsafe to replace
+    (see :func:`react3d_core.atomic.check_output_dir`) or a scene id is not a plain folder name
+    (``..`` would put a scene's output at the parent of ``out_root``). Returns the scenes."""
+    root_p = Path(root)
+    if not root_p.is_dir():
+        raise InputError(root_p, "dataset folder not found")
+    for s in scene_ids or []:
+        if s in ("", ".", "..") or "/" in s or "\\" in s:
+            raise InputError(root_p / s, "a scene id must be the name of a sub-folder of the dataset folder")
+    out = Path(out_root)
+    if out.is_symlink() or (out.exists() and not out.is_dir()):
+        raise InputError(out, "exists and is not a folder; choose a new --out folder")
+    scenes = find_scenes(root_p, scene_ids, glob)
+    for scene in scenes:
+        check_output_dir(out / scene.name, (scene, root_p), kind=OUTPUT_KIND)
+    return scenes
 
 
 def _one(scene: Path, out_root: Path, config: dict[str, Any] | None) -> dict[str, Any]:
@@ -57,7 +81,7 @@ def convert_dataset(root: str, scene_ids: list[str] | None = None, glob: str | N
                     out_root: str = "react3d_out", config: dict[str, Any] | None = None,
                     scene_concurrency: int = 1) -> list[dict[str, Any]]:
     """Convert every selected scene under ``root`` into ``out_root/<scene>``; returns one row per scene."""
-    scenes = find_scenes(root, scene_ids, glob)
+    scenes = check_dataset_outputs(root, scene_ids, glob, out_root)
     out = Path(out_root)
     rows: list[dict[str, Any]] = []
     progress = None

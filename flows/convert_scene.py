@@ -22,7 +22,8 @@ from prefect.task_runners import ThreadPoolTaskRunner  # noqa: E402
 
 from react3d_core.config import PipelineConfig  # noqa: E402
 from tasks.articulation import articulate_part  # noqa: E402
-from tasks.assembly import assemble, export, publish  # noqa: E402
+from react3d_core.atomic import atomic_dir, check_output_dir  # noqa: E402
+from tasks.assembly import OUTPUT_KIND, assemble, export, output_marker, stage_output  # noqa: E402
 from tasks.keys import stage_version  # noqa: E402
 from tasks.perception import perceive_frames  # noqa: E402
 from tasks.report import evaluate, finalize, report  # noqa: E402
@@ -72,6 +73,7 @@ def _chunks(items: list[str], n: int) -> list[list[str]]:
 def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None = None) -> str:
     """Convert the scan at ``scene_path`` into ``out_dir``; returns the manifest path (``scene.json``)."""
     t_all = time.perf_counter()
+    out = check_output_dir(out_dir, (scene_path,), kind=OUTPUT_KIND)  # before any stage runs
     cfg = PipelineConfig().with_overrides(config or {})
     c = cfg.model_dump(mode="json")
     frames_cfg = c["frames"]
@@ -101,22 +103,26 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
         asm = done(assemble(scene_path, sha, frames_cfg, parts, config_sections(c, ASSEMBLY_KEYS)))
 
     formats = list(cfg.export.formats)
-    with _stage("export", 1, prog, timings if formats else {}) as done:
-        # no formats (accuracy benchmarks): publish the assembled scene without simulator files
-        exp = export(asm, c["export"], formats) if formats else asm
-        manifest = done(publish(exp, out_dir, fp["mesh_path"]))
-
     metrics = None
-    if fp["gt_dir"]:
-        t = time.perf_counter()
-        metrics = evaluate(manifest, fp["gt_dir"], c)
-        timings["evaluation"] = time.perf_counter() - t
-    timings["total"] = time.perf_counter() - t_all
     versions = {m: stage_version(m) for m in STAGE_MODULES}
-    finalize(manifest, c, versions, timings)
-    with _stage("report", 1, prog, timings) as done:
-        html = done(report(manifest, scene_path, frames_cfg, metrics))
-    finalize(manifest, c, versions, timings)
+    # Everything the user gets (manifest with config and timings, metrics, report) is built in a staging
+    # sibling and renamed onto ``out`` in one step: a kill at any point leaves the old output as it was.
+    with atomic_dir(out, marker=output_marker(scene_path)) as staging:
+        with _stage("export", 1, prog, timings if formats else {}) as done:
+            # no formats (accuracy benchmarks): publish the assembled scene without simulator files
+            exp = export(asm, c["export"], formats) if formats else asm
+            staged = done(stage_output(exp, str(staging), str(out), fp["mesh_path"]))
+        if fp["gt_dir"]:
+            t = time.perf_counter()
+            metrics = evaluate(staged, fp["gt_dir"], c)
+            timings["evaluation"] = time.perf_counter() - t
+        timings["total"] = time.perf_counter() - t_all
+        finalize(staged, c, versions, timings)
+        with _stage("report", 1, prog, timings) as done:
+            done(report(staged, scene_path, frames_cfg, metrics))
+        finalize(staged, c, versions, timings)
+        check_output_dir(out, (scene_path,), kind=OUTPUT_KIND)  # nothing of the user's appeared there meanwhile
+    manifest, html = str(out / "scene.json"), str(out / "report.html")
     publish_scene_artifacts(fp["scene_id"], manifest, html, timings, metrics,
                             n_candidates=seg["n"], n_rejected=sum(p.get("kind") == "rejected" for p in parts))
     return manifest

@@ -17,12 +17,12 @@ from typing import Any
 
 from prefect import task
 
-from react3d_core.atomic import atomic_dir
+from react3d_core.atomic import atomic_dir, check_output_dir
 from react3d_core.config import ExportConfig, PipelineConfig
 
 from .keys import canonical, content_key, stage_version
 from .scene import scan_mesh, scene_input
-from .store import cache_root, get
+from .store import cache_root, get, seal_dir
 
 
 def _dir_for(stage: str, inputs: Any) -> Path:
@@ -43,6 +43,7 @@ def assemble_body(scene_path: str, scene_sha: str, frames_cfg: dict[str, Any], p
     arts = [get(h) for h in parts if h.get("kind") != "rejected"]
     with atomic_dir(out) as tmp:
         assemble_scene(scene, scan_mesh(str(scene.mesh_path)), arts, cfg, tmp)
+    seal_dir(out)  # cache hits are verified against it (tasks.store.verify_dir)
     return {"sha256": out.name, "path": str(out / "scene.json"), "kind": "assembled-scene",
             "seconds": time.perf_counter() - t0}
 
@@ -66,6 +67,7 @@ def export_body(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: 
     with atomic_dir(out) as tmp:
         shutil.copytree(src, tmp, dirs_exist_ok=True)
         export_scene(tmp / "scene.json", tuple(formats), ExportConfig.model_validate(export_cfg))
+    seal_dir(out)
     return {"sha256": out.name, "path": str(out / "scene.json"), "kind": "exported-scene",
             "seconds": time.perf_counter() - t0}
 
@@ -77,26 +79,59 @@ def export(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: list[
     return export_body(assembled, export_cfg, formats)
 
 
-def publish_body(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None) -> str:
-    """Copy the finished folder to ``out_dir`` as a whole (atomic rename); returns the manifest path.
+OUTPUT_KIND = "scene"
+"""The ``kind`` in the marker of a conversion output (``react3d_core.atomic.OUTPUT_MARKER``)."""
+
+
+def output_marker(scene_path: str | None = None) -> dict[str, Any]:
+    """What a conversion output's marker records: that react3d wrote it, for which scan, when."""
+    return {"kind": OUTPUT_KIND, "scene": str(Path(scene_path).resolve()) if scene_path else None,
+            "created": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+
+
+def fill_output(result: dict[str, Any], staging: str | Path, out_dir: str | Path,
+                scan_mesh_path: str | None = None) -> str:
+    """Copy the finished store folder into ``staging`` (a sibling of ``out_dir`` that will be renamed onto
+    it); returns the staged manifest path.
 
     The stored result is keyed by content, so it may come from a run on another copy of the scan:
-    ``scan_mesh_path`` (this run's mesh) is what the published manifest refers to."""
+    ``scan_mesh_path`` (this run's mesh) is what the published manifest refers to, relative to
+    ``out_dir`` (the same relative path from the staging sibling)."""
     from react3d_core.data.parts import InteractiveScene
 
     src = Path(result["path"]).parent
-    out = Path(out_dir).resolve()
+    staging, out = Path(staging), Path(out_dir)
+    if staging.parent.resolve() != out.parent.resolve():
+        raise ValueError(f"staging folder {staging} must be a sibling of {out}")
     manifest = InteractiveScene.load(src / "scene.json")
     mesh = Path(scan_mesh_path) if scan_mesh_path else Path(manifest.input_mesh)
     mesh = mesh.resolve() if mesh.is_absolute() or scan_mesh_path else (src / mesh).resolve()
-    with atomic_dir(out) as tmp:
-        shutil.copytree(src, tmp, dirs_exist_ok=True)
-        # the scan mesh stays where it is: re-point the manifest's reference from the new folder
-        rel = os.path.relpath(mesh, out)
-        manifest.model_copy(update={"input_mesh": rel}).save(tmp / "scene.json")
+    shutil.copytree(src, staging, dirs_exist_ok=True)
+    # the scan mesh stays where it is: re-point the manifest's reference from the new folder
+    rel = os.path.relpath(mesh, out.resolve())
+    manifest.model_copy(update={"input_mesh": rel}).save(staging / "scene.json")
+    return str(staging / "scene.json")
+
+
+def publish_body(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None,
+                 inputs: tuple[str, ...] = ()) -> str:
+    """Copy the finished folder to ``out_dir`` as a whole (atomic rename); returns the manifest path.
+
+    ``out_dir`` is checked first (:func:`react3d_core.atomic.check_output_dir`): only a new/empty folder
+    or a previous react3d output that holds none of ``inputs`` is replaced. The flow does not use this:
+    it stages the manifest, metrics and report together (``flows/convert_scene.py``)."""
+    out = check_output_dir(out_dir, inputs, kind=OUTPUT_KIND)
+    with atomic_dir(out, marker=output_marker(inputs[0] if inputs else None)) as tmp:
+        fill_output(result, tmp, out, scan_mesh_path)
     return str(out / "scene.json")
 
 
 @task(name="publish", persist_result=False)
 def publish(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None) -> str:
     return publish_body(result, out_dir, scan_mesh_path)
+
+
+@task(name="stage-output", persist_result=False)
+def stage_output(result: dict[str, Any], staging: str, out_dir: str, scan_mesh_path: str | None = None) -> str:
+    """Fill the staging folder that becomes ``out_dir`` once the report is written too."""
+    return fill_output(result, staging, out_dir, scan_mesh_path)

@@ -11,7 +11,7 @@ HELP = "Convert one scan (ScanNet++ iPhone/DSLR, prepared, mesh + transforms.jso
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("scene", help="Scene folder.")
-    p.add_argument("--out", required=True, help="Output folder (replaced atomically when the run finishes).")
+    p.add_argument("--out", required=True, help="Output folder: new, empty, or a previous react3d output (replaced atomically when the run finishes).")
     add_pipeline_arguments(p)
 
 
@@ -21,7 +21,10 @@ def run(args: argparse.Namespace) -> int:
     from ._runconfig import pipeline_overrides, run_with_progress
     from .summary import print_summary
 
+    from react3d_core.atomic import check_output_dir
+
     cfg = pipeline_overrides(args)
+    check_output_dir(args.out, (args.scene,), kind="scene")  # before Prefect starts: one line, nothing touched
     manifest = run_with_progress(args.scene, args.out, cfg, f"converting {args.scene}")
     print_summary(Console(), manifest)
     return 0

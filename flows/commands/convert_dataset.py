@@ -29,7 +29,10 @@ def run(args: argparse.Namespace) -> int:
     prefect_env.configure()
     from flows.convert_dataset import convert_dataset
 
+    from flows.convert_dataset import check_dataset_outputs
+
     cfg = pipeline_overrides(args)
+    check_dataset_outputs(args.root, args.scenes, args.glob, args.out)  # before any scene runs
     console = Console()
     with console.status("converting scenes (per-scene progress in the Prefect UI when a server is configured)"):
         rows = convert_dataset(args.root, args.scenes, args.glob, args.out, cfg, args.concurrency)

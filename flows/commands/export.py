@@ -20,6 +20,17 @@ def run(args: argparse.Namespace) -> int:
     from react3d_core.errors import ConfigError
     from react3d_core.export import export_scene
 
+    from pathlib import Path
+
+    from react3d_core.atomic import is_react3d_output
+    from react3d_core.errors import InputError
+
+    folder = Path(args.out)
+    folder = folder.parent if folder.name == "scene.json" and not folder.is_dir() else folder
+    if not is_react3d_output(folder, "scene"):
+        # export replaces folders under OUT/export: only inside an output react3d wrote
+        raise InputError(folder, "is not a react3d conversion output (no .react3d-output marker); "
+                                 "give the --out folder of a `react3d convert` run")
     cfg = PipelineConfig.from_file(args.config).export if args.config else PipelineConfig().export
     updates: dict = {}
     if args.ros_package:

@@ -28,11 +28,17 @@ def run(args: argparse.Namespace) -> int:
 
     from react3d_core.synthetic import generate_scene
 
+    from react3d_core import __version__
+    from react3d_core.atomic import OUTPUT_MARKER, check_output_dir
+
+    check_output_dir(args.out, (args.urdf,) if args.urdf else (), kind="synth")  # never replace the user's files
     console = Console()
     t0 = time.perf_counter()
     with console.status(f"rendering {args.frames} frames ({args.source}, seed {args.seed})"):
         out = generate_scene(args.out, source=args.source, seed=args.seed, n_frames=args.frames,
                              urdf_path=args.urdf, kind=args.kind, edge=args.edge)
+    # deterministic (hidden files stay out of scan fingerprints): lets a later synth replace this folder
+    (Path(out) / OUTPUT_MARKER).write_text(json.dumps({"react3d": __version__, "kind": "synth"}))
     meta = json.loads((Path(out) / "synth_meta.json").read_text())
     if args.preview:
         from react3d_core.synthetic.preview import write_preview
