@@ -36,7 +36,13 @@ def canonical(x: Any) -> Any:
 
 
 def content_key(stage: str, modules: tuple[str, ...], ignore: tuple[str, ...] = ("scene_path", "out_dir")) -> Callable[[Any, dict[str, Any]], str]:
-    """A Prefect ``cache_key_fn`` for ``stage`` whose code lives in ``modules``."""
+    """A Prefect ``cache_key_fn`` for ``stage`` whose code lives in ``modules``.
+
+    Defining a cached task also installs the result-record guard: a cache hit is read only from a JSON
+    record whose objects verify (``tasks.prefect_env.guard_result_records``)."""
+    from .prefect_env import guard_result_records
+
+    guard_result_records()
 
     def key(_ctx: Any, params: dict[str, Any]) -> str:
         body = {

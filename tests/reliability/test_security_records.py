@@ -1,0 +1,153 @@
+"""Item 4 of issue 20: a forged Prefect result record in the shared storage must never run code.
+
+Prefect 3 decodes a record with the serializer the record itself names. These tests forge records the
+way an attacker with write access to ``$PREFECT_HOME/storage`` would (``serializer: pickle``, and JSON
+with ``jsonlib: pickle``), each carrying a payload that creates a marker file when unpickled, and run a
+real ``react3d convert`` process on a real (temporary) Prefect server over them.
+"""
+
+from __future__ import annotations
+
+import base64
+import contextlib
+import json
+import os
+import pickle
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class _Touch:
+    """Unpickling this object creates ``path`` (a stand-in for any code an attacker would run)."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = str(path)
+
+    def __reduce__(self):  # noqa: ANN204 - pickle protocol
+        return (open, (self.path, "w"))
+
+
+def _pickle_record(marker: Path) -> dict:
+    payload = base64.b64encode(pickle.dumps(_Touch(marker))).decode()
+    return {"metadata": {"storage_key": None, "expiration": None,
+                         "serializer": {"type": "pickle", "picklelib": "cloudpickle", "picklelib_version": None},
+                         "prefect_version": "3.8.8", "storage_block_id": None},
+            "result": payload}
+
+
+def _json_pickle_record(marker: Path) -> dict:
+    """Type 'json' but ``jsonlib: pickle``: a check of the serializer's type alone would let this run."""
+    return {"metadata": {"storage_key": None, "expiration": None,
+                         "serializer": {"type": "json", "jsonlib": "pickle", "object_encoder": None,
+                                        "object_decoder": None, "dumps_kwargs": {}, "loads_kwargs": {}},
+                         "prefect_version": "3.8.8", "storage_block_id": None},
+            "result": pickle.dumps(_Touch(marker), protocol=0).decode("latin-1")}
+
+
+# --- the check itself, on the bytes Prefect would decode ------------------------------------------------
+
+def _real_json_record(result: object) -> bytes:
+    from prefect._internal.result_records import ResultRecord, ResultRecordMetadata
+    from prefect.serializers import JSONSerializer
+
+    return ResultRecord(metadata=ResultRecordMetadata(serializer=JSONSerializer()), result=result).serialize()
+
+
+def test_json_records_written_by_prefect_pass_the_check() -> None:
+    from tasks.prefect_env import check_record_bytes
+
+    handle = {"sha256": "ab" * 32, "path": "/x/ab.npz", "kind": "perception", "seconds": 1.5, "frame_ids": ["f1"]}
+    assert check_record_bytes(_real_json_record(handle)) == handle
+
+
+@pytest.mark.parametrize("forge", [
+    lambda m: _pickle_record(m),
+    lambda m: _json_pickle_record(m),
+    lambda m: {**_pickle_record(m), "metadata": {**_pickle_record(m)["metadata"],
+                                                 "serializer": {"type": "compressed/pickle", "compressionlib": "lzma",
+                                                                "serializer": {"type": "pickle"}}}},
+    lambda m: {"data": _pickle_record(m)["result"], "serializer": {"type": "pickle"}},  # legacy layout
+    lambda m: {"metadata": {"serializer": {"type": "json", "jsonlib": "json", "object_encoder": None,
+                                           "object_decoder": "pickle.loads", "dumps_kwargs": {}, "loads_kwargs": {}}},
+               "result": "{}"},
+    lambda m: {"metadata": json.loads(_real_json_record(0))["metadata"],
+               "result": json.dumps({"__class__": "subprocess.Popen", "data": ["touch", str(m)]})},
+    lambda m: base64.b64encode(pickle.dumps(_Touch(m))).decode(),  # not a record: Prefect would try its backup serializer
+], ids=["pickle", "json-with-pickle-lib", "compressed-pickle", "legacy", "object-decoder", "foreign-class", "bare-pickle"])
+def test_forged_records_are_refused_before_decoding(tmp_path: Path, forge) -> None:  # noqa: ANN001
+    from prefect._internal.result_records import ResultRecord
+
+    from tasks.prefect_env import UntrustedRecordError, guard_result_records
+
+    guard_result_records()
+    marker = tmp_path / "pwned"
+    data = json.dumps(forge(marker)).encode()
+    with pytest.raises(UntrustedRecordError):
+        ResultRecord.deserialize(data)
+    forged = forge(marker)
+    if isinstance(forged, dict):  # the same record split into metadata + result (a metadata_storage layout)
+        with pytest.raises(UntrustedRecordError):
+            ResultRecord.deserialize_from_result_and_metadata(
+                str(forged.get("result", forged.get("data"))).encode(), json.dumps(forged.get("metadata", forged)).encode())
+    assert not marker.exists()
+
+
+# --- a real convert over a forged storage ---------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def env(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
+    home = tmp_path_factory.mktemp("prefect-home")
+    e = {k: v for k, v in os.environ.items() if not k.startswith(("PREFECT_", "REACT3D_"))}
+    e.update(PREFECT_HOME=str(home), PREFECT_LOCAL_STORAGE_PATH=str(home / "storage"),
+             REACT3D_CACHE=str(home / "react3d-cache"), PYTHONPATH=str(ROOT),
+             PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS="300")
+    return e
+
+
+def convert(scene: Path, out: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """``react3d convert`` in its own process group (oracle perception: fast, deterministic); whatever
+    the group leaves running (Prefect's temporary server) is ended afterwards."""
+    p = subprocess.Popen([sys.executable, "-m", "flows.cli", "convert", str(scene), "--out", str(out),
+                          "--perception", "oracle", "--stride", "2", "--formats", "urdf"],
+                         env=env, cwd=ROOT, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                         start_new_session=True)
+    try:
+        out_text, err_text = p.communicate(timeout=900)
+    finally:
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(p.pid, signal.SIGKILL)
+    return subprocess.CompletedProcess(p.args, p.returncode, out_text, err_text)
+
+
+def test_forged_records_in_shared_storage_do_not_run(synthetic_scene, env: dict[str, str], tmp_path: Path) -> None:  # noqa: ANN001
+    scene = synthetic_scene(seed=5, n_frames=12, kind="dresser")
+    first = convert(scene, tmp_path / "a", env)
+    assert first.returncode == 0, first.stderr[-3000:]
+    storage = Path(env["PREFECT_LOCAL_STORAGE_PATH"])
+    records = sorted(p for p in storage.iterdir() if p.is_file() and p.name.split("-")[0] in
+                     {"perception", "segmentation", "articulation", "assembly", "export"})
+    assert {p.name.split("-")[0] for p in records} >= {"perception", "segmentation", "export"}
+    markers = []
+    for i, rec in enumerate(records):  # every cached stage's records forged, alternating the two tricks
+        marker = tmp_path / f"pwned-{i}"
+        markers.append(marker)
+        rec.write_text(json.dumps((_pickle_record if i % 2 == 0 else _json_pickle_record)(marker)))
+
+    second = convert(scene, tmp_path / "b", env)
+
+    assert [m.name for m in markers if m.exists()] == []  # nothing ran
+    assert second.returncode == 0, second.stderr[-3000:]  # ... and the convert recomputed
+    assert "ignored a cached Prefect result record" in second.stderr
+    a = json.loads((tmp_path / "a" / "scene.json").read_text())
+    b = json.loads((tmp_path / "b" / "scene.json").read_text())
+    assert [o["articulation"] for o in a["objects"]] == [o["articulation"] for o in b["objects"]]
+    # the forged records were replaced by the recomputation's JSON records
+    for rec in records:
+        meta = json.loads(rec.read_text())["metadata"]
+        assert meta["serializer"]["type"] == "json" and meta["serializer"]["jsonlib"] == "json", rec.name
