@@ -6,6 +6,8 @@ opened from a remote box's shared folder. ``react3d view`` serves the same page.
 
 from __future__ import annotations
 
+import base64
+import hashlib
 import html
 import json
 from importlib import resources
@@ -35,6 +37,7 @@ header{padding:10px 16px;background:#1f2937;color:#fff}header h1{font-size:18px;
 main{padding:8px 16px}table{border-collapse:collapse;font-size:13px;margin:6px 0 16px}
 td,th{border:1px solid #ddd;padding:3px 8px;text-align:left;vertical-align:middle}th{background:#f3f4f6}
 td img{height:72px;margin-right:3px}
+#r3d-toggles{margin:6px 0}#r3d-status{color:#666;margin-top:6px}
 """
 
 _APP = """
@@ -42,7 +45,7 @@ _APP = """
   <div id="r3d-stage"><canvas id="r3d-canvas"></canvas><div id="r3d-labels"></div></div>
   <div id="r3d-side">
     <div><button id="r3d-open">open all</button> <button id="r3d-close">close all</button></div>
-    <div style="margin:6px 0">
+    <div id="r3d-toggles">
       <label><input type="checkbox" id="r3d-show-background">background</label>
       <label><input type="checkbox" id="r3d-show-cavities">cavities</label>
       <label><input type="checkbox" id="r3d-show-axes">joint axes</label>
@@ -50,7 +53,7 @@ _APP = """
     </div>
     <div id="r3d-joints"></div>
     <div id="r3d-info"></div>
-    <div id="r3d-status" style="color:#666;margin-top:6px"></div>
+    <div id="r3d-status"></div>
   </div>
 </div>
 """
@@ -65,15 +68,31 @@ def _json_for_script(obj: Any) -> str:
     return json.dumps(obj, separators=(",", ":")).replace("</", "<\\/")
 
 
+def _sha256_source(text: str) -> str:
+    return "'sha256-" + base64.b64encode(hashlib.sha256(text.encode("utf-8")).digest()).decode() + "'"
+
+
+def content_security_policy(scripts: list[str], styles: list[str]) -> str:
+    """The page's CSP: only these exact inline scripts and styles run (by sha256), images only inline
+    (``data:``), nothing loaded or sent anywhere: injected markup can neither run nor phone home."""
+    return ("default-src 'none'; "
+            f"script-src {' '.join(_sha256_source(s) for s in scripts)}; "
+            f"style-src {' '.join(_sha256_source(s) for s in styles)}; "
+            "img-src data:; base-uri 'none'; form-action 'none'")
+
+
 def build_viewer_html(payload: dict[str, Any], title: str, body: str = "", thumbs: dict[str, list[str]] | None = None) -> str:
-    """One HTML page: viewer + optional extra body (tables)."""
+    """One HTML page: viewer + optional extra body (tables), under a hash-based Content-Security-Policy."""
+    data = f"window.REACT3D_SCENE={_json_for_script(payload)};window.REACT3D_THUMBS={_json_for_script(thumbs or {})};"
+    viewer = _viewer_js()
+    csp = content_security_policy([data, viewer], [_CSS])
     return (
         "<!doctype html><html><head><meta charset='utf-8'>"
+        f"<meta http-equiv='Content-Security-Policy' content=\"{csp}\">"
         f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>"
         f"<header><h1>{html.escape(title)}</h1></header>{_APP}<main>{body}</main>"
-        f"<script>window.REACT3D_SCENE={_json_for_script(payload)};"
-        f"window.REACT3D_THUMBS={_json_for_script(thumbs or {})};</script>"
-        f"<script>{_viewer_js()}</script></body></html>"
+        f"<script>{data}</script>"
+        f"<script>{viewer}</script></body></html>"
     )
 
 
@@ -93,7 +112,7 @@ def _parts_table(scene: InteractiveScene, thumbs: dict[str, list[str]]) -> str:
             lim = f"{np.degrees(a.lower):.0f}° … {np.degrees(a.upper):.0f}°"
         else:
             lim = f"{a.lower:.3f} … {a.upper:.3f} m"
-        imgs = "".join(f"<img src='{t}'>" for t in thumbs.get(o.object_id, []))
+        imgs = "".join(f"<img src='{html.escape(t)}'>" for t in thumbs.get(o.object_id, []) if t.startswith("data:image/"))
         views = ", ".join(f"{v.get('frame_id')} ({v.get('iou', 0):.2f})" for v in o.top_views[:5])
         rows.append(
             f"<tr><td>{html.escape(o.object_id)}</td><td>{html.escape(o.label)}</td><td>{a.joint_type}</td>"

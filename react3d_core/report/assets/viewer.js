@@ -276,17 +276,27 @@
   // ---------- UI ----------
   const info = document.getElementById("r3d-info");
   const fmt = (x, d) => (x === null || x === undefined ? "–" : Number(x).toFixed(d));
+  // Everything shown here comes from the manifest (labels, frame ids, limit sources): text nodes only,
+  // never innerHTML, so a frame file named `frame<img onerror=...>` stays text.
+  function el(tag, text) { const e = document.createElement(tag); if (text !== undefined) e.textContent = String(text); return e; }
   function select(o) {
     selected = o;
-    if (!o) { info.innerHTML = "<em>Click an object to see its joint.</em>"; requestDraw(); return; }
+    info.replaceChildren();
+    if (!o) { info.append(el("em", "Click an object to see its joint.")); requestDraw(); return; }
     const s = o.src, j = s.joint, deg = j.type === "revolute";
     const lim = deg ? `${fmt(j.lower * 180 / Math.PI, 1)}° … ${fmt(j.upper * 180 / Math.PI, 1)}°` : `${fmt(j.lower, 3)} … ${fmt(j.upper, 3)} m`;
     const views = (s.top_views || []).map((v) => `${v.frame_id} (IoU ${fmt(v.iou, 2)})`).join(", ") || "–";
     const thumbs = (window.REACT3D_THUMBS && window.REACT3D_THUMBS[s.id]) || [];
-    info.innerHTML = `<b>${s.id}</b> · ${s.label}<br>type: <b>${j.type}</b>, limits ${lim} (${j.limit_source})<br>` +
-      `axis [${j.axis.map((v) => fmt(v, 3)).join(", ")}], origin [${j.origin.map((v) => fmt(v, 3)).join(", ")}]<br>` +
-      `confidence ${fmt(s.score, 2)} · cavity ${fmt(s.cavity_depth, 3)} m (${s.cavity_depth_source || "–"})<br>source views: ${views}` +
-      thumbs.map((t) => `<img class="r3d-thumb" src="${t}">`).join("");
+    info.append(
+      el("b", s.id), ` · ${s.label}`, el("br"),
+      "type: ", el("b", j.type), `, limits ${lim} (${j.limit_source})`, el("br"),
+      `axis [${j.axis.map((v) => fmt(v, 3)).join(", ")}], origin [${j.origin.map((v) => fmt(v, 3)).join(", ")}]`, el("br"),
+      `confidence ${fmt(s.score, 2)} · cavity ${fmt(s.cavity_depth, 3)} m (${s.cavity_depth_source || "–"})`, el("br"),
+      `source views: ${views}`);
+    for (const t of thumbs) {
+      if (typeof t !== "string" || !t.startsWith("data:image/")) continue;  // thumbnails are inline images only
+      const img = el("img"); img.className = "r3d-thumb"; img.src = t; info.append(img);
+    }
     requestDraw();
   }
   const list = document.getElementById("r3d-joints");
