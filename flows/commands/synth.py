@@ -17,6 +17,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--urdf", default=None, help="Articulated URDF for --source urdf.")
     p.add_argument("--preview", action="store_true", help="Also write preview.png (frames beside GT part ids).")
     p.add_argument("--edge", type=float, default=None, help="Furniture triangle size in metres (default 0.03 procedural, 0.05 others).")
+    p.add_argument("--mesh", default="clean", choices=["clean", "laser", "tsdf"],
+                   help="Written scan mesh: the generated geometry, a laser-like 5 mm remesh (1.5 mm range noise) or a "
+                        "1 cm TSDF of the scene's own noisy depth + colour frames; GT is transferred to it.")
+    p.add_argument("--realism", default="photo", choices=["plain", "photo"],
+                   help="RGB renderer: photo (materials, highlights, light falloff, exposure, blur) or plain flat shading.")
+    p.add_argument("--misregister", default="0,0", metavar="DX,DY",
+                   help="Shift colour against depth by DX,DY pixels of the RGB image, like a Kinect (photo only).")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -35,8 +42,10 @@ def run(args: argparse.Namespace) -> int:
     console = Console()
     t0 = time.perf_counter()
     with console.status(f"rendering {args.frames} frames ({args.source}, seed {args.seed})"):
+        dx, dy = (float(x) for x in args.misregister.split(","))
         out = generate_scene(args.out, source=args.source, seed=args.seed, n_frames=args.frames,
-                             urdf_path=args.urdf, kind=args.kind, edge=args.edge)
+                             urdf_path=args.urdf, kind=args.kind, edge=args.edge, mesh=args.mesh,
+                             realism=args.realism, misregister=(dx, dy))
     # deterministic (hidden files stay out of scan fingerprints): lets a later synth replace this folder
     (Path(out) / OUTPUT_MARKER).write_text(json.dumps({"react3d": __version__, "kind": "synth"}))
     meta = json.loads((Path(out) / "synth_meta.json").read_text())
@@ -45,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
 
         console.print(f"preview: {write_preview(out)}")
     types = [p["type"] for p in meta["parts"]]
-    console.print(f"[green]wrote[/green] {out}: {meta['kind']}, {meta['faces']} faces, {meta['n_frames']} frames, "
+    console.print(f"[green]wrote[/green] {out}: {meta['kind']}, {meta['mesh']['kind']} mesh, {meta['faces']} faces, "
+                  f"{meta['realism']} images, {meta['n_frames']} frames, "
                   f"{len(types)} joints ({types.count('revolute')} revolute, {types.count('prismatic')} prismatic) "
                   f"in {time.perf_counter() - t0:.1f} s")
     return 0

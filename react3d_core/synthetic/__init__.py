@@ -10,12 +10,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .materials import REALISM
 from .procedural import KINDS, SynthLayout, build_room
+from .remesh import MESH_KINDS
 from .writer import GENERATOR_VERSION, write_synthetic
 
 STAGE_VERSION = GENERATOR_VERSION
 SOURCES = ("procedural", "scene-synthesizer", "urdf")
-__all__ = ["KINDS", "SOURCES", "STAGE_VERSION", "build_room", "demo_scene", "generate_scene"]
+__all__ = ["KINDS", "MESH_KINDS", "REALISM", "SOURCES", "STAGE_VERSION", "build_room", "demo_scene", "generate_scene"]
 
 
 def _room_depths(layout: SynthLayout) -> list[float]:
@@ -25,11 +27,15 @@ def _room_depths(layout: SynthLayout) -> list[float]:
 
 
 def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 0, n_frames: int = 60,
-                   urdf_path: str | Path | None = None, kind: str | None = None, edge: float | None = None) -> Path:
+                   urdf_path: str | Path | None = None, kind: str | None = None, edge: float | None = None,
+                   mesh: str = "clean", realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0)) -> Path:
     """Build, render and write one synthetic scene; returns ``out_dir``.
 
     ``kind`` picks the procedural room type (default by seed), ``edge`` the triangle size of the
     furniture (smaller = denser meshes, for scaling benchmarks; default 3 cm procedural, 5 cm others).
+    ``mesh`` (clean | laser | tsdf) re-makes the written scan mesh like a real scan, ``realism``
+    (photo | plain) picks the image renderer, ``misregister`` shifts colour against depth by (dx, dy)
+    pixels (see :func:`.writer.write_synthetic`).
     """
     edge = edge if edge is not None else (0.03 if source == "procedural" else 0.05)
     if source == "procedural":
@@ -46,7 +52,8 @@ def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 
         layout = build_from_urdf(Path(urdf_path), seed, edge=edge)
     else:
         raise ValueError(f"unknown source {source!r}; choose from {', '.join(SOURCES)}")
-    return write_synthetic(layout, out_dir, n_frames, seed, source, room_depths=_room_depths(layout))
+    return write_synthetic(layout, out_dir, n_frames, seed, source, room_depths=_room_depths(layout), mesh=mesh,
+                           realism=realism, misregister=misregister)
 
 
 def demo_scene(out_dir: str | Path) -> Path:

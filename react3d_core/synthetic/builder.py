@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..data.mesh import TriMesh
+from .materials import MATTE
 
 # The six faces of a unit cube as (normal axis, sign); grids are emitted per face so each face has
 # its own vertices (like a scan, faces of different planes are not welded).
@@ -64,6 +65,8 @@ class MeshBuilder:
     _faces: list[np.ndarray] = field(default_factory=list)
     _cols: list[np.ndarray] = field(default_factory=list)
     _keys: list[np.ndarray] = field(default_factory=list)
+    _mats: list[np.ndarray] = field(default_factory=list)
+    _base: list[np.ndarray] = field(default_factory=list)
     _n: int = 0
     _key_ids: dict[str, int] = field(default_factory=dict)
 
@@ -74,8 +77,10 @@ class MeshBuilder:
         return self._key_ids.setdefault(key, len(self._key_ids))
 
     def add(self, verts: np.ndarray, faces: np.ndarray, color: tuple[int, int, int], key: str | None = None,
-            transform: np.ndarray | None = None, noise: float = 6.0) -> None:
-        """Add a piece; ``transform`` (4x4) places it in the world; colours get a little per-vertex noise."""
+            transform: np.ndarray | None = None, noise: float = 6.0, material: int = MATTE) -> None:
+        """Add a piece; ``transform`` (4x4) places it in the world; colours get a little per-vertex noise.
+
+        ``material`` (see :mod:`.materials`) only drives the photo-realistic renderer; it changes no geometry."""
         if transform is not None:
             verts = verts @ transform[:3, :3].T + transform[:3, 3]
         rng = np.random.default_rng(self.seed * 7919 + len(self._verts))
@@ -84,17 +89,27 @@ class MeshBuilder:
         self._faces.append(faces + self._n)
         self._cols.append(col.astype(np.uint8))
         self._keys.append(np.full(len(faces), self.key_id(key), np.int32))
+        self._mats.append(np.full(len(faces), material, np.uint8))
+        self._base.append(np.broadcast_to(np.asarray(color, np.uint8)[None], (len(faces), 3)))
         self._n += len(verts)
 
     def add_box(self, lo, hi, color, key: str | None = None, transform: np.ndarray | None = None,  # noqa: ANN001
-                skip: tuple[tuple[int, int], ...] = ()) -> None:
+                skip: tuple[tuple[int, int], ...] = (), material: int = MATTE) -> None:
         v, f = box_mesh(np.asarray(lo, float), np.asarray(hi, float), self.edge, skip)
-        self.add(v, f, color, key, transform)
+        self.add(v, f, color, key, transform, material=material)
 
     def build(self) -> tuple[TriMesh, np.ndarray, dict[str, int]]:
         """The merged mesh, the part-key id of every face (-1 = none) and the key -> id table."""
         mesh = TriMesh(np.concatenate(self._verts), np.concatenate(self._faces), np.concatenate(self._cols))
         return mesh, np.concatenate(self._keys), dict(self._key_ids)
+
+    def materials(self) -> np.ndarray:
+        """Material id of every face, in the order of :meth:`build`."""
+        return np.concatenate(self._mats) if self._mats else np.zeros(0, np.uint8)
+
+    def base_colors(self) -> np.ndarray:
+        """The colour each face was added with (no per-vertex noise): the photo renderer's albedo."""
+        return np.concatenate(self._base) if self._base else np.zeros((0, 3), np.uint8)
 
 
 def bisect_to_size(verts: np.ndarray, faces: np.ndarray, edge: float, max_iter: int = 16) -> tuple[np.ndarray, np.ndarray]:

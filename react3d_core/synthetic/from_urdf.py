@@ -22,6 +22,7 @@ from ..data.parts import Articulation
 from ..errors import InputError
 from .builder import MeshBuilder, bisect_to_size
 from .furniture import PartSpec, WallFrame
+from .materials import GLOSSY, MATTE, METAL, WOOD
 from .procedural import SynthLayout, ViewRun, shell
 
 SKIP = re.compile(r"basket|rack", re.I)  # internal sliding parts (dishwasher baskets) are not fronts
@@ -101,11 +102,13 @@ def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "
     m = MeshBuilder(edge=edge, seed=seed)
     shell(m, rng, W, L, H, None)
     statics: dict[str, str] = {}
+    front_mat = (GLOSSY, WOOD, MATTE)[seed % 3]  # one front finish per scene (photo renderer only)
     for key in sorted(pieces):
+        mat = METAL if key.endswith(".handle") else MATTE if key.startswith("static:") else front_mat
         for v, f, col in pieces[key]:
             # hidden carcass boards need fewer triangles than the fronts the pipeline segments
             vv, ff = _subdivide(v + offset, f, edge * (2.5 if key.startswith("static:") else 1.5))
-            m.add(vv, ff, col, key)
+            m.add(vv, ff, col, key, material=mat)
         if key.startswith("static:"):
             statics[key] = key.split(":", 1)[1]
     parts: list[PartSpec] = []
@@ -131,7 +134,7 @@ def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "
     runs = _runs(mesh, keys, key_ids, parts, W, L)
     return SynthLayout(mesh, keys, key_ids, parts, statics, runs, (W, L, H), kind,
                        extra={"urdf": str(path.name), "offset": offset.tolist(), "skipped_joints": [j.name for j in movable if SKIP.search(j.name)]},
-                       observed_only=True)
+                       observed_only=True, face_materials=m.materials(), face_colors=m.base_colors())
 
 
 def _runs(mesh, keys, key_ids, parts: list[PartSpec], W: float, L: float) -> list[ViewRun]:  # noqa: ANN001

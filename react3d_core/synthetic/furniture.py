@@ -14,6 +14,7 @@ import numpy as np
 
 from ..data.parts import Articulation
 from .builder import MeshBuilder
+from .materials import GLOSSY, MATTE, METAL, WOOD
 
 BOARD = 0.018       # carcass board thickness
 FRONT = 0.019       # front slab thickness
@@ -56,18 +57,22 @@ class PartSpec:
 
 @dataclass
 class Palette:
+    """Colours plus the materials the photo renderer gives fronts and carcasses (handles are metal)."""
+
     front: tuple[int, int, int]
     carcass: tuple[int, int, int]
     handle: tuple[int, int, int]
+    material: int = MATTE
+    carcass_material: int = MATTE
 
 
 PALETTES = [
-    Palette((235, 232, 225), (225, 222, 214), (70, 70, 75)),
-    Palette((120, 85, 55), (105, 75, 50), (200, 200, 205)),
-    Palette((60, 90, 120), (230, 228, 222), (210, 210, 212)),
-    Palette((170, 140, 100), (160, 130, 95), (40, 40, 42)),
-    Palette((90, 110, 85), (220, 215, 205), (190, 160, 80)),
-    Palette((200, 60, 50), (230, 230, 230), (60, 60, 60)),
+    Palette((235, 232, 225), (225, 222, 214), (70, 70, 75), GLOSSY),
+    Palette((120, 85, 55), (105, 75, 50), (200, 200, 205), WOOD, WOOD),
+    Palette((60, 90, 120), (230, 228, 222), (210, 210, 212), GLOSSY),
+    Palette((170, 140, 100), (160, 130, 95), (40, 40, 42), WOOD, WOOD),
+    Palette((90, 110, 85), (220, 215, 205), (190, 160, 80), MATTE),
+    Palette((200, 60, 50), (230, 230, 230), (60, 60, 60), GLOSSY),
 ]
 
 
@@ -101,7 +106,7 @@ class Builder:
         T = frame.T
         key = name
         y0, y1 = -PROUD - thickness, -PROUD
-        self.mesh.add_box([x0, y0, z0], [x1, y1, z1], pal.front, key, T)
+        self.mesh.add_box([x0, y0, z0], [x1, y1, z1], pal.front, key, T, material=pal.material)
         ym = 0.5 * (y0 + y1)
         zm, xm = 0.5 * (z0 + z1), 0.5 * (x0 + x1)
         w, h = x1 - x0, z1 - z0
@@ -132,7 +137,7 @@ class Builder:
                 lo, hi = [hx - ln / 2, y0 - proud, hz - bar / 2], [hx + ln / 2, y0, hz + bar / 2]
             else:
                 lo, hi = [hx - bar / 2, y0 - proud, hz - ln / 2], [hx + bar / 2, y0, hz + ln / 2]
-            self.mesh.add_box(lo, hi, pal.handle, hkey, T, skip=((1, 1),))
+            self.mesh.add_box(lo, hi, pal.handle, hkey, T, skip=((1, 1),), material=METAL)
         label = f"{label_base}.{kind.split('_')[0]}_{len(self.parts) + 1}"
         spec = PartSpec(key, label, kind.split("_")[0], art, carcass_key, hkey, depth)
         self.parts.append(spec)
@@ -141,19 +146,19 @@ class Builder:
     def carcass(self, frame: WallFrame, name: str, W: float, D: float, z0: float, H: float, shelves: list[float],
                 pal: Palette, plinth: float = 0.0) -> None:
         """Open-front box: two sides, top, bottom, back and horizontal dividers at heights ``shelves``."""
-        T, c, t = frame.T, pal.carcass, BOARD
+        T, c, t, mat = frame.T, pal.carcass, BOARD, pal.carcass_material
         m = self.mesh
         edge, m.edge = m.edge, m.edge * 1.8  # boards are mostly hidden: coarser, like a decimated scan
         zt = z0 + H
         if plinth > 0:
             m.add_box([0.02, 0.05, 0.0], [W - 0.02, D, z0], (50, 50, 52), name, T)
-        m.add_box([0, 0, z0], [t, D, zt], c, name, T)
-        m.add_box([W - t, 0, z0], [W, D, zt], c, name, T)
-        m.add_box([t, 0, z0], [W - t, D - t, z0 + t], c, name, T)
-        m.add_box([t, 0, zt - t], [W - t, D - t, zt], c, name, T)
-        m.add_box([t, D - t, z0], [W - t, D, zt], c, name, T)
+        m.add_box([0, 0, z0], [t, D, zt], c, name, T, material=mat)
+        m.add_box([W - t, 0, z0], [W, D, zt], c, name, T, material=mat)
+        m.add_box([t, 0, z0], [W - t, D - t, z0 + t], c, name, T, material=mat)
+        m.add_box([t, 0, zt - t], [W - t, D - t, zt], c, name, T, material=mat)
+        m.add_box([t, D - t, z0], [W - t, D, zt], c, name, T, material=mat)
         for z in shelves:
-            m.add_box([t, 0, z - t / 2], [W - t, D - t, z + t / 2], c, name, T)
+            m.add_box([t, 0, z - t / 2], [W - t, D - t, z + t / 2], c, name, T, material=mat)
         m.edge = edge
 
     def cabinet(self, frame: WallFrame, W: float, D: float, z0: float, H: float, cells: list[tuple[float, str]],
@@ -181,11 +186,12 @@ class Builder:
                 self.front(frame, self._name(name + "_f"), lay, g, W - g, za_, zb_, pal, handles, name, depth, label_base)
         return name
 
-    def static_box(self, frame: WallFrame, lo, hi, color, label: str | None = None) -> None:  # noqa: ANN001
+    def static_box(self, frame: WallFrame, lo, hi, color, label: str | None = None,  # noqa: ANN001
+                   material: int = MATTE) -> None:
         key = self._name(label) if label else None
         if key:
             self.statics[key] = label  # type: ignore[assignment]
-        self.mesh.add_box(lo, hi, color, key, frame.T)
+        self.mesh.add_box(lo, hi, color, key, frame.T, material=material)
 
     def room_door(self, frame: WallFrame, x0: float, width: float, height: float, wall_t: float, pal: Palette) -> None:
         """A door slab in a wall opening [x0, x0+width] x [0, height] (wall frame at the inner wall face),
@@ -194,17 +200,18 @@ class Builder:
         name = self._name("door_frame")
         cas, cd = 0.06, 0.015
         x1 = x0 + width
-        self.mesh.add_box([x0 - cas, -cd, 0], [x0, wall_t, height + cas], pal.carcass, name, T)
-        self.mesh.add_box([x1, -cd, 0], [x1 + cas, wall_t, height + cas], pal.carcass, name, T)
-        self.mesh.add_box([x0, -cd, height], [x1, wall_t, height + cas], pal.carcass, name, T)
+        cm = pal.carcass_material
+        self.mesh.add_box([x0 - cas, -cd, 0], [x0, wall_t, height + cas], pal.carcass, name, T, material=cm)
+        self.mesh.add_box([x1, -cd, 0], [x1 + cas, wall_t, height + cas], pal.carcass, name, T, material=cm)
+        self.mesh.add_box([x0, -cd, height], [x1, wall_t, height + cas], pal.carcass, name, T, material=cm)
         self.statics[name] = "door_frame"
         key = self._name("room_door")
         t = 0.04
         ya, yb = 0.01, 0.01 + t
-        self.mesh.add_box([x0 + 0.003, ya, 0.01], [x1 - 0.003, yb, height - 0.003], pal.front, key, T)
+        self.mesh.add_box([x0 + 0.003, ya, 0.01], [x1 - 0.003, yb, height - 0.003], pal.front, key, T, material=pal.material)
         art = self._world_joint(frame, "revolute", [0, 0, -1], [x0 + 0.003, 0.5 * (ya + yb), height / 2], float(np.radians(100)))
         hkey = key + ".handle"
         hx, hz = x1 - 0.07, 1.0
-        self.mesh.add_box([hx - 0.13, ya - 0.055, hz - 0.01], [hx, ya - 0.04, hz + 0.01], pal.handle, hkey, T)
-        self.mesh.add_box([hx - 0.012, ya - 0.04, hz - 0.012], [hx + 0.012, ya, hz + 0.012], pal.handle, hkey, T)
+        self.mesh.add_box([hx - 0.13, ya - 0.055, hz - 0.01], [hx, ya - 0.04, hz + 0.01], pal.handle, hkey, T, material=METAL)
+        self.mesh.add_box([hx - 0.012, ya - 0.04, hz - 0.012], [hx + 0.012, ya, hz + 0.012], pal.handle, hkey, T, material=METAL)
         self.parts.append(PartSpec(key, f"door.door_{len(self.parts) + 1}", "room_door", art, name, hkey, None))

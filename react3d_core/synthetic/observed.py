@@ -47,4 +47,7 @@ def keep_faces(layout: SynthLayout, keep: np.ndarray) -> SynthLayout:
         parts.append(p if has(p.handle_key) else replace(p, handle_key=None))
     statics = {k: v for k, v in layout.statics.items() if has(k)}
     extra = {**layout.extra, "culled_faces": int((~keep).sum()), "unobserved_parts": dropped}
-    return replace(layout, mesh=mesh, face_keys=keys, parts=parts, statics=statics, extra=extra)
+    mats = layout.face_materials[keep] if layout.face_materials is not None else None
+    cols = layout.face_colors[keep] if layout.face_colors is not None else None
+    return replace(layout, mesh=mesh, face_keys=keys, parts=parts, statics=statics, extra=extra, face_materials=mats,
+                   face_colors=cols)

@@ -14,6 +14,7 @@ import numpy as np
 from ..data.mesh import TriMesh
 from .builder import MeshBuilder
 from .furniture import PALETTES, Builder, PartSpec, WallFrame
+from .materials import STONE, WOOD
 
 KINDS = ("kitchen", "wardrobe", "dresser", "room_door", "mixed")
 WALL_T = 0.12
@@ -46,6 +47,8 @@ class SynthLayout:
     # keep only surfaces a capture of the closed scene observes (see observed.py); URDF models hold
     # internal geometry (drawer boxes, appliance insides) that no scan and no Articulate3D label has
     observed_only: bool = False
+    face_materials: np.ndarray | None = None  # per face, see materials.py (None: all matte)
+    face_colors: np.ndarray | None = None     # per face albedo for the photo renderer (None: vertex colours)
 
 
 def wall_frames(W: float, L: float) -> list[tuple[WallFrame, float]]:
@@ -63,7 +66,8 @@ def shell(m: MeshBuilder, rng: np.random.Generator, W: float, L: float, H: float
     """Floor, ceiling and four walls; ``door`` = (wall index, x0, width, height) cuts an opening."""
     edge, m.edge = m.edge, max(0.12, float(np.sqrt(W * L)) / 35.0)  # plain walls: coarse, like a decimated scan
     wall_col = tuple(int(c) for c in rng.integers(200, 245, 3))
-    m.add_box([-WALL_T, -WALL_T, -0.05], [W + WALL_T, L + WALL_T, 0.0], tuple(int(c) for c in rng.integers(110, 170, 3)))
+    m.add_box([-WALL_T, -WALL_T, -0.05], [W + WALL_T, L + WALL_T, 0.0], tuple(int(c) for c in rng.integers(110, 170, 3)),
+              material=WOOD)
     m.add_box([-WALL_T, -WALL_T, H], [W + WALL_T, L + WALL_T, H + 0.05], (235, 235, 235))
     for k, (fr, length) in enumerate(wall_frames(W, L)):
         T = fr.T
@@ -77,7 +81,7 @@ def shell(m: MeshBuilder, rng: np.random.Generator, W: float, L: float, H: float
         fr, _ = wall_frames(W, L)[door[0]]
         _, x0, dw, dh = door
         m.add_box([x0 - 0.5, WALL_T + 1.2, 0.0], [x0 + dw + 0.5, WALL_T + 1.3, H], (90, 90, 95), None, fr.T)
-        m.add_box([x0 - 0.5, WALL_T, -0.05], [x0 + dw + 0.5, WALL_T + 1.2, 0.0], (120, 110, 100), None, fr.T)
+        m.add_box([x0 - 0.5, WALL_T, -0.05], [x0 + dw + 0.5, WALL_T + 1.2, 0.0], (120, 110, 100), None, fr.T, material=WOOD)
     m.edge = edge
 
 
@@ -112,7 +116,7 @@ def _kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
     total = x - x_start
     if total <= 0:
         return
-    b.static_box(fr.shifted(x_start, -D - 0.02), [0, 0, Hb], [total, D + 0.02, Hb + 0.03], (70, 70, 72), "countertop")
+    b.static_box(fr.shifted(x_start, -D - 0.02), [0, 0, Hb], [total, D + 0.02, Hb + 0.03], (70, 70, 72), "countertop", material=STONE)
     z1 = Hb + 0.03
     if rng.random() < 0.7 and H > 2.3:  # wall cabinets
         Dw, z0w, Hw = 0.35, Hb + 0.6, min(0.7, H - Hb - 0.7)
@@ -192,4 +196,5 @@ def build_room(seed: int, kind: str | None = None, edge: float = 0.03) -> SynthL
         fr, length = frames[k]
         fn(b, fr, length, rng, runs, H)
     mesh, keys, key_ids = m.build()
-    return SynthLayout(mesh, keys, key_ids, b.parts, b.statics, runs, (W, L, H), kind)
+    return SynthLayout(mesh, keys, key_ids, b.parts, b.statics, runs, (W, L, H), kind, face_materials=m.materials(),
+                       face_colors=m.base_colors())

@@ -1,7 +1,8 @@
 """Render synthetic RGB-D frames by ray casting: shaded RGB, sensor-like depth, GT part-id images.
 
 RGB colours are vertex colours interpolated barycentrically at the hit (Open3D returns the hit's
-barycentric uv), shaded with a head light plus a ceiling light. Depth is rendered at the iPhone
+barycentric uv), shaded with a head light plus a ceiling light (``realism="plain"``; the photo-like
+renderer is :mod:`.materials`). Depth is rendered at the iPhone
 LiDAR size and degraded like a sensor: relative noise, drop-outs at depth discontinuities and
 random holes, all from a seeded generator.
 """
@@ -47,7 +48,8 @@ class RayCaster:
         self._colors = self.mesh.colors.astype(np.float32)
 
     def cast(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int) -> dict[str, np.ndarray]:
-        """Per pixel: z-depth (inf = miss), face id (-1), barycentric uv, unit ray direction, face normal."""
+        """Per pixel: z-depth (inf = miss), face id (-1), barycentric uv, unit ray direction, face normal,
+        world hit point (0 where nothing is hit)."""
         import open3d as o3d
 
         # same pixel convention as react3d_core.raster.Rasterizer: integer pixel coordinates are centres
@@ -58,10 +60,12 @@ class RayCaster:
         ans = self._scene.cast_rays(o3d.core.Tensor(np.ascontiguousarray(rays.reshape(-1, 6), dtype=np.float32)))
         t = ans["t_hit"].numpy().reshape(height, width)
         ids = ans["primitive_ids"].numpy().astype(np.int64).reshape(height, width)
-        ids[~np.isfinite(t)] = -1
+        hit = np.isfinite(t)
+        ids[~hit] = -1
+        point = np.where(hit[..., None], c2w[:3, 3].astype(np.float32) + np.where(hit, t, 0.0)[..., None] * dw, 0.0)
         return {"depth": t, "face": ids, "uv": ans["primitive_uvs"].numpy().reshape(height, width, 2),
                 "normal": ans["primitive_normals"].numpy().reshape(height, width, 3),
-                "dir": dw / np.linalg.norm(dw, axis=-1, keepdims=True)}
+                "dir": dw / np.linalg.norm(dw, axis=-1, keepdims=True), "point": point.astype(np.float32)}
 
     def rgb(self, hit: dict[str, np.ndarray], rng: np.random.Generator) -> np.ndarray:
         """Shaded colour image (uint8 RGB); misses are black."""

@@ -17,15 +17,19 @@ import cv2
 import numpy as np
 
 from ..atomic import atomic_dir, write_json
-from ..data.mesh import save_mesh
+from ..data.mesh import TriMesh, save_mesh
 from ..ground_truth.articulate3d import GroundTruth, GTPart, write_articulate3d
 from ..scene_io.depth_bin import write_depth_bin
 from .camera_path import camera_walk
+from .materials import REALISM, PhotoSettings, render_photo, scene_lights
 from .observed import keep_faces, observed_faces
 from .procedural import SynthLayout
+from .remesh import (LASER_VOXEL, MESH_KINDS, TRANSFER_RADIUS, TSDF_VOXEL, TsdfFuser, laser_depth, transfer_labels,
+                     transfer_parts)
 from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, sensor_depth
 
-GENERATOR_VERSION = "2"  # 2: URDF sources keep only observed surfaces
+# 2: URDF sources keep only observed surfaces; 3: photo realism (default) and laser / TSDF scan meshes
+GENERATOR_VERSION = "3"
 
 
 def _gt_parts(layout: SynthLayout) -> tuple[list[GTPart], np.ndarray, list[dict]]:
@@ -63,12 +67,57 @@ def _gt_parts(layout: SynthLayout) -> tuple[list[GTPart], np.ndarray, list[dict]
     return parts, face_pid, meta
 
 
+def _ray_norm(K: np.ndarray, width: int, height: int) -> np.ndarray:
+    """Per pixel the length of the camera ray with z = 1 (ray length = z-depth x this)."""
+    u, v = np.meshgrid(np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32))
+    return np.sqrt(((u - K[0, 2]) / K[0, 0]) ** 2 + ((v - K[1, 2]) / K[1, 1]) ** 2 + 1.0).astype(np.float32)
+
+
+def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: list[GTPart], face_pid: np.ndarray,
+                 meta: list[dict]) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
+    """The fused scan mesh, the GT moved onto it, the meta rows of the parts kept and mesh statistics."""
+    new = fuser.mesh()
+    tr = transfer_labels(layout.mesh, face_pid, new)
+    if kind == "laser":  # a laser scan is coloured from registered photos: the clean colour at the surface
+        new = TriMesh(new.vertices, new.faces, tr.colors)
+    parts, dropped = transfer_parts(gt_parts, tr)
+    n_faces = {p.part_id: len(p.tri_indices) for p in parts}
+    rows = []
+    for r in meta:
+        if r["part_id"] not in n_faces:
+            continue
+        rows.append({**r, "n_faces": n_faces[r["part_id"]],
+                     "handle_part_id": r["handle_part_id"] if r["handle_part_id"] in n_faces else None,
+                     "handle": r["handle_part_id"] in n_faces,
+                     "parent_part_id": r["parent_part_id"] if r["parent_part_id"] in n_faces else None})
+    stats = {"kind": kind, "voxel": LASER_VOXEL if kind == "laser" else TSDF_VOXEL,
+             "clean_faces": layout.mesh.n_faces, "clean_vertices": layout.mesh.n_vertices,
+             "transfer_radius": TRANSFER_RADIUS, "labelled_vertices": float((tr.vertex_label >= 0).mean()),
+             "median_distance_to_clean": float(np.median(tr.distance)) if len(tr.distance) else None,
+             "dropped_parts": dropped}
+    return new, parts, rows, stats
+
+
 def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, seed: int, source: str,
-                    scene_id: str | None = None, room_depths: list[float] | None = None) -> Path:
-    """Render ``n_frames`` views of ``layout`` and write the scene folder; returns ``out_dir``."""
+                    scene_id: str | None = None, room_depths: list[float] | None = None, mesh: str = "clean",
+                    realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0)) -> Path:
+    """Render ``n_frames`` views of ``layout`` and write the scene folder; returns ``out_dir``.
+
+    ``mesh``: the written scan mesh, ``clean`` (the generated geometry), ``laser`` or ``tsdf`` (re-made
+    like a real scan, GT transferred; see :mod:`.remesh`). ``realism``: ``photo`` (materials, lights,
+    exposure, blur; :mod:`.materials`) or ``plain`` (flat shading, the generator-version-2 images).
+    ``misregister``: colour shifted by (dx, dy) RGB pixels against depth and poses (photo only).
+    """
     out_dir = Path(out_dir)
     if n_frames < 1:
         raise ValueError("n_frames must be >= 1")
+    if mesh not in MESH_KINDS:
+        raise ValueError(f"unknown mesh {mesh!r}; choose from {', '.join(MESH_KINDS)}")
+    if realism not in REALISM:
+        raise ValueError(f"unknown realism {realism!r}; choose from {', '.join(REALISM)}")
+    misregister = (float(misregister[0]), float(misregister[1]))
+    if realism == "plain" and misregister != (0.0, 0.0):
+        raise ValueError("misregister needs realism='photo'")
     rng = np.random.default_rng(seed + 1_000_003)
     scene_id = scene_id or out_dir.name
     K = base_intrinsics(rng)
@@ -82,15 +131,25 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
         layout = keep_faces(layout, observed_faces(caster, dense + poses, K))
         caster = RayCaster(layout.mesh)
     gt_parts, face_pid, meta = _gt_parts(layout)
+    face_mat = layout.face_materials if layout.face_materials is not None else np.zeros(layout.mesh.n_faces, np.uint8)
+    photo = PhotoSettings(scene_lights(layout.room), misregister=misregister)
+    fuser = {"clean": None, "laser": TsdfFuser(LASER_VOXEL, color=False, depth_scale=5000.0),
+             "tsdf": TsdfFuser(TSDF_VOXEL, color=True)}[mesh]
+    ray_norm = _ray_norm(K_rgb, *RGB_SIZE)
     with atomic_dir(out_dir) as tmp:
         (tmp / "iphone" / "rgb").mkdir(parents=True)
         (tmp / "iphone" / "gt_part_ids").mkdir(parents=True)
-        save_mesh(tmp / "scans" / "mesh_aligned_0.05.ply", layout.mesh)
         depths, pose_json = [], {}
         for i, c2w in enumerate(poses):
             fid = f"frame_{i:06d}"
             hit = caster.cast(K_rgb, c2w, *RGB_SIZE)
-            rgb = caster.rgb(hit, rng)
+            if realism == "photo":  # its own per-frame generator: depth noise below stays that of 'plain'
+                rgb = render_photo(hit, layout.mesh.faces, layout.mesh.colors, face_mat, photo,
+                                   np.random.default_rng([seed, i, 0x5EED]), rng, layout.face_colors)
+            else:
+                rgb = caster.rgb(hit, rng)
+            if mesh == "laser":
+                fuser.add(laser_depth(hit["depth"], ray_norm, np.random.default_rng([seed, i, 0x1A5E])), K_rgb, c2w)
             cv2.imwrite(str(tmp / "iphone" / "rgb" / f"{fid}.jpg"), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR),
                         [cv2.IMWRITE_JPEG_QUALITY, 92])
             face = hit["face"]
@@ -98,12 +157,19 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
             cv2.imwrite(str(tmp / "iphone" / "gt_part_ids" / f"{fid}.png"), pid.astype(np.uint16))
             dhit = caster.cast(K_d, c2w, *DEPTH_SIZE)
             depths.append(sensor_depth(dhit["depth"], rng))
+            if mesh == "tsdf":
+                fuser.add(depths[-1], K_d, c2w, rgb)
             pose_json[fid] = {"intrinsic": K.tolist(), "aligned_pose": c2w.tolist(), "timestamp": round(i / 10.0, 3)}
+        scan, mesh_stats = layout.mesh, {"kind": "clean"}
+        if fuser is not None:
+            scan, gt_parts, meta, mesh_stats = _remeshed_gt(layout, fuser, mesh, gt_parts, face_pid, meta)
+        save_mesh(tmp / "scans" / "mesh_aligned_0.05.ply", scan)
         write_depth_bin(tmp / "iphone" / "depth.bin", depths, "per_frame")
         write_json(tmp / "iphone" / "pose_intrinsic_imu.json", pose_json)
-        write_articulate3d(tmp / "articulate3d", GroundTruth(scene_id, gt_parts, layout.mesh.n_faces, layout.mesh.n_vertices))
+        write_articulate3d(tmp / "articulate3d", GroundTruth(scene_id, gt_parts, scan.n_faces, scan.n_vertices))
         write_json(tmp / "synth_meta.json", {
             "generator_version": GENERATOR_VERSION, "source": source, "seed": seed, "kind": layout.kind,
             "scene_id": scene_id, "n_frames": len(poses), "room": list(layout.room),
-            "faces": layout.mesh.n_faces, "vertices": layout.mesh.n_vertices, "parts": meta, **layout.extra})
+            "faces": scan.n_faces, "vertices": scan.n_vertices, "parts": meta, "mesh": mesh_stats,
+            "realism": realism, "misregister_px": list(misregister), **layout.extra})
     return out_dir
