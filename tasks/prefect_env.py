@@ -148,19 +148,21 @@ def guard_result_records() -> None:
 
             try:
                 verify_handles(check_record_bytes(data))
-            except (UntrustedRecordError, CorruptObjectError) as exc:
+            except UntrustedRecordError as exc:
                 _refuse(data, exc)
+                raise
+            except CorruptObjectError:  # the store already said so in one line (quarantine)
                 raise
             # never fall back to a serializer for bytes that are not a record
             return orig_deserialize(cls, data, backup_serializer=None)
 
         def deserialize_from_result_and_metadata(cls: type, result: bytes, metadata: bytes) -> Any:
-            from .store import CorruptObjectError, verify_handles
+            from .store import verify_handles
 
             try:
                 check_metadata(metadata)
                 verify_handles(check_payload(result))
-            except (UntrustedRecordError, CorruptObjectError) as exc:
+            except UntrustedRecordError as exc:
                 _refuse(metadata + result, exc)
                 raise
             return orig_split(cls, result, metadata)
