@@ -54,9 +54,11 @@ def load_spec(spec: str, out_dir: Path, frames: int | None = None) -> list[dict[
             out = []
             for e in d["scenes"]:
                 src, seed, kind = e.get("source", "procedural"), int(e["seed"]), e.get("kind")
-                name = f"{src}_{kind or 'any'}_{seed}"
+                # scan realism (generate_scene's mesh / realism / misregister) is part of the scene's name
+                opts = {k: e[k] for k in ("mesh", "realism", "misregister") if k in e}
+                name = "_".join([f"{src}_{kind or 'any'}_{seed}"] + [str(opts[k]) for k in ("mesh", "realism") if k in opts])
                 out.append({"name": name, "source": src, "kind": kind, "seed": seed, "n_frames": int(e.get("n_frames", n)),
-                            "scene_dir": str(out_dir / "scenes" / f"{name}_f{int(e.get('n_frames', n))}")})
+                            "scene_dir": str(out_dir / "scenes" / f"{name}_f{int(e.get('n_frames', n))}"), "synth": opts})
             return out
         except (KeyError, TypeError, ValueError, json.JSONDecodeError) as exc:
             raise InputError(cand, f"bad benchmark set ({exc.__class__.__name__}: {exc})") from None
@@ -103,7 +105,8 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
     if "source" in entry and not (scene_dir / "scans").is_dir():
         from react3d_core.synthetic import generate_scene
 
-        generate_scene(scene_dir, source=entry["source"], seed=entry["seed"], n_frames=entry["n_frames"], kind=entry.get("kind"))
+        generate_scene(scene_dir, source=entry["source"], seed=entry["seed"], n_frames=entry["n_frames"], kind=entry.get("kind"),
+                       **entry.get("synth", {}))
     from flows.convert_scene import convert_scene
 
     rss0 = _peak_rss_mb()

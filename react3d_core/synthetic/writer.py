@@ -24,8 +24,8 @@ from .camera_path import camera_walk
 from .materials import REALISM, PhotoSettings, render_photo, scene_lights
 from .observed import keep_faces, observed_faces
 from .procedural import SynthLayout
-from .remesh import (LASER_VOXEL, MESH_KINDS, TRANSFER_RADIUS, TSDF_VOXEL, TsdfFuser, laser_depth, transfer_labels,
-                     transfer_parts)
+from .remesh import (LASER_DECIMATION, LASER_VOXEL, MESH_KINDS, TRANSFER_RADIUS, TSDF_VOXEL, TsdfFuser, decimate,
+                     laser_depth, transfer_labels, transfer_parts)
 from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, sensor_depth
 
 # 2: URDF sources keep only observed surfaces; 3: photo realism (default) and laser / TSDF scan meshes
@@ -77,6 +77,8 @@ def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: lis
                  meta: list[dict]) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
     """The fused scan mesh, the GT moved onto it, the meta rows of the parts kept and mesh statistics."""
     new = fuser.mesh()
+    if kind == "laser":
+        new = decimate(new, LASER_DECIMATION)
     tr = transfer_labels(layout.mesh, face_pid, new)
     if kind == "laser":  # a laser scan is coloured from registered photos: the clean colour at the surface
         new = TriMesh(new.vertices, new.faces, tr.colors)
@@ -91,6 +93,7 @@ def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: lis
                      "handle": r["handle_part_id"] in n_faces,
                      "parent_part_id": r["parent_part_id"] if r["parent_part_id"] in n_faces else None})
     stats = {"kind": kind, "voxel": LASER_VOXEL if kind == "laser" else TSDF_VOXEL,
+             "decimation": LASER_DECIMATION if kind == "laser" else 0.0,
              "clean_faces": layout.mesh.n_faces, "clean_vertices": layout.mesh.n_vertices,
              "transfer_radius": TRANSFER_RADIUS, "labelled_vertices": float((tr.vertex_label >= 0).mean()),
              "median_distance_to_clean": float(np.median(tr.distance)) if len(tr.distance) else None,
