@@ -1,9 +1,12 @@
 """Perception backends and their thresholds (tags, 2D masks, point prompts, articulation predictor)."""
 
+import re
 from typing import Literal
+from urllib.parse import parse_qsl, urlsplit
 
-from pydantic import Field
+from pydantic import Field, ValidationInfo, field_validator
 
+from ..errors import ConfigError
 from ._base import StageConfig
 
 
@@ -43,3 +46,41 @@ class PerceptionConfig(StageConfig):
     batch_size: int = Field(8, ge=1, description="Frames per model call on GPU.")
     device: str = Field("auto", description="'auto', 'cpu', 'cuda', 'cuda:N'.")
     oracle: OracleNoiseConfig = Field(default_factory=OracleNoiseConfig)
+
+    @field_validator("tag_filter_endpoint", "articulation_endpoint")
+    @classmethod
+    def _no_credentials(cls, value: str | None, info: ValidationInfo) -> str | None:
+        """Endpoints are recorded in scene.json and in Prefect's flow-run parameters, so they must not carry a
+        secret: keys come from the environment (REACT3D_LLM_API_KEY / OPENAI_API_KEY,
+        REACT3D_OPDMULTI_API_KEY) or a Prefect Secret block, never from the config."""
+        if value:
+            where = endpoint_credential(value)
+            if where:
+                field = info.field_name
+                # ConfigError, not ValueError: pydantic would wrap a ValueError and echo the input (the key)
+                raise ConfigError(f"perception.{field} carries a credential ({where}); it would be stored in scene.json "
+                                 "and Prefect's run parameters. Remove it and set the key in the environment "
+                                 "(REACT3D_LLM_API_KEY, REACT3D_OPDMULTI_API_KEY; docs/reliability.md) "
+                                 "or in a Prefect Secret block")
+        return value
+
+
+_URL = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*://[^\s'\"]+")
+_SECRET_NAME = re.compile(r"^(.*[-_])?(api[-_]?key|key|token|access[-_]?token|secret|password|passwd|pwd|auth|"
+                          r"authorization|signature|sig|credentials?)$", re.IGNORECASE)
+_SECRET_FLAG = re.compile(r"(?:^|\s)--?(api[-_]?key|token|access[-_]?token|secret|password|auth)(?:[=\s]|$)", re.IGNORECASE)
+
+
+def endpoint_credential(value: str) -> str | None:
+    """Where ``value`` (a URL, or a command that may contain URLs) carries a credential, else None:
+    user info in a URL, a query parameter named like a key/token, or a ``--api-key``-style flag."""
+    for url in _URL.findall(value):
+        parts = urlsplit(url)
+        if "@" in parts.netloc:
+            return "user name/password in the URL"
+        for name, _ in parse_qsl(parts.query, keep_blank_values=True):
+            if _SECRET_NAME.match(name):
+                return f"query parameter {name!r}"
+    m = _SECRET_FLAG.search(value)
+    return f"command-line flag {m.group(0).strip().split('=')[0]!r}" if m else None
+

@@ -9,7 +9,6 @@ Each model is loaded once per worker process (runtime.load_cached); nothing is d
 from __future__ import annotations
 
 import logging
-import os
 
 from react3d_core.config import PerceptionConfig
 from react3d_core.perception.interfaces import ArticulationPredictor, Perception
@@ -18,7 +17,7 @@ from .grounded_sam import GroundedSamSegmenter, SamPointSegmenter
 from .loaders import load_causal_lm, load_clip, load_detector, load_sam
 from .opdmulti import NoArticulationPredictor, OPDMultiClient
 from .options import ModelOptions, model_options
-from .runtime import ModelUnavailableError, load_cached, resolve_device, resolve_dtype
+from .runtime import ModelNeed, ModelUnavailableError, api_key, check_models_available, load_cached, resolve_device, resolve_dtype
 from .tag_filter import CachedTagFilter, chat_asker, local_lm_asker
 from .tagger import ClipTagger
 
@@ -42,12 +41,18 @@ def make_model_perception(config: PerceptionConfig) -> Perception:
     opts = model_options(config)
     device = resolve_device(config.device)
     dtype = resolve_dtype(opts.dtype, device)
+    needs = [ModelNeed("Grounding DINO", config.detector_model, "detector_model"),
+             ModelNeed("SAM", config.sam_model, "sam_model"),
+             ModelNeed("CLIP tagger", _tagger_id(config, opts), "tagger_model")]
+    if not config.tag_filter_endpoint:
+        needs.append(ModelNeed("tag-filter language model", config.tag_filter_model, "tag_filter_model"))
+    check_models_available(needs)  # offline first: seconds, not minutes of hub retries
     det = load_cached("detector", config.detector_model, device, dtype, load_detector, "Grounding DINO", "detector_model")
     sam = load_cached("sam", config.sam_model, device, dtype, load_sam, "SAM", "sam_model")
     clip = load_cached("clip", _tagger_id(config, opts), device, dtype, load_clip, "CLIP tagger", "tagger_model")
     if config.tag_filter_endpoint:
         ask = chat_asker(config.tag_filter_endpoint, config.tag_filter_model, opts.llm_timeout_s, opts.llm_retries,
-                         opts.llm_backoff_s, api_key=os.environ.get("REACT3D_LLM_API_KEY") or os.environ.get("OPENAI_API_KEY"))
+                         opts.llm_backoff_s, api_key=api_key(("REACT3D_LLM_API_KEY", "OPENAI_API_KEY"), "REACT3D_LLM_API_KEY_BLOCK"))
         retries = opts.llm_retries
     else:
         lm = load_cached("lm", config.tag_filter_model, device, dtype, load_causal_lm, "tag-filter language model", "tag_filter_model")
@@ -56,7 +61,8 @@ def make_model_perception(config: PerceptionConfig) -> Perception:
     articulation: ArticulationPredictor
     if config.articulation_endpoint:
         articulation = OPDMultiClient(config.articulation_endpoint, opts.articulation_timeout_s, opts.articulation_min_score,
-                                      batch_size=config.batch_size)
+                                      batch_size=config.batch_size,
+                                      api_key=api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK"))
     else:
         articulation = NoArticulationPredictor()
     return Perception(

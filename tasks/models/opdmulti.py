@@ -126,17 +126,20 @@ class OPDMultiClient:
     """ArticulationPredictor over the JSON contract: 'http(s)://…' is POSTed to, anything else is a command."""
 
     def __init__(self, endpoint: str, timeout_s: float, min_score: float, retries: int = 2, backoff_s: float = 1.0,
-                 batch_size: int = 8) -> None:
+                 batch_size: int = 8, api_key: str | None = None) -> None:
         self.endpoint, self.timeout_s, self.min_score = endpoint, timeout_s, min_score
         self.retries, self.backoff_s, self.batch_size = retries, backoff_s, batch_size
         self.is_http = endpoint.startswith(("http://", "https://"))
+        self._headers = {"Content-Type": "application/json"}
+        if api_key:  # from the environment or a Secret block, never from the config (it is recorded)
+            self._headers["Authorization"] = f"Bearer {api_key}"
 
     def _call(self, payload: bytes) -> Any:
         last: Exception | None = None
         for attempt in range(self.retries + 1):
             try:
                 if self.is_http:
-                    req = urllib.request.Request(self.endpoint, data=payload, headers={"Content-Type": "application/json"}, method="POST")
+                    req = urllib.request.Request(self.endpoint, data=payload, headers=self._headers, method="POST")
                     with urllib.request.urlopen(req, timeout=self.timeout_s) as resp:
                         return json.loads(resp.read())
                 proc = subprocess.run(shlex.split(self.endpoint), input=payload, capture_output=True, timeout=self.timeout_s, check=False)
