@@ -103,6 +103,123 @@ def clear_cache() -> None:
 
 
 def pretrained(cls: Any, model_id: str, device: torch.device, dtype: torch.dtype) -> Any:
-    """``cls.from_pretrained`` in eval mode on ``device``/``dtype`` (no download when HF_HUB_OFFLINE=1)."""
-    model = cls.from_pretrained(model_id, dtype=dtype)
+    """``cls.from_pretrained`` in eval mode on ``device``/``dtype`` (no hub request for a local copy)."""
+    model = cls.from_pretrained(model_id, dtype=dtype, **hub_kwargs(model_id))
     return model.to(device).eval()
+
+
+# --- offline first: know what is on this machine before anything talks to the hub --------------------
+#
+# Without weights, ``from_pretrained`` on a closed network retried the hub for minutes (197 s and 238 log
+# lines before the clear message). Every model the backend needs is now looked up locally first (a
+# folder, or the Hugging Face cache); only what is missing may be downloaded, and only from a hub that
+# answers a single short probe. Otherwise one line names every missing model and how to get it.
+
+HUB_PROBE_TIMEOUT_S = 3.0
+
+
+@dataclass(frozen=True)
+class ModelNeed:
+    """One model the backend will load: what it is, its hub id or folder, and the config field naming it."""
+
+    what: str
+    model_id: str
+    config_field: str
+
+
+def _looks_like_path(model_id: str) -> bool:
+    return model_id.startswith(("/", ".", "~")) or model_id.count("/") > 1 or os.sep == "\\" and "\\" in model_id
+
+
+def locally_available(model_id: str) -> bool:
+    """True when ``model_id`` is a folder here, or a hub id whose config is in the Hugging Face cache."""
+    path = Path(model_id).expanduser()
+    if path.exists() or _looks_like_path(model_id):
+        return path.is_dir()
+    try:
+        from huggingface_hub import try_to_load_from_cache
+
+        return isinstance(try_to_load_from_cache(model_id, "config.json"), str)
+    except Exception:  # noqa: BLE001 - an invalid repo id is simply not available
+        return False
+
+
+def hub_kwargs(model_id: str) -> dict[str, Any]:
+    """``from_pretrained`` keywords: a model found locally is read with ``local_files_only`` (no hub requests)."""
+    return {"local_files_only": True} if locally_available(model_id) else {}
+
+
+def hub_offline() -> bool:
+    """HF_HUB_OFFLINE (or TRANSFORMERS_OFFLINE) is set to a true value."""
+    return any(os.environ.get(k, "").strip().upper() in ("1", "ON", "YES", "TRUE")
+               for k in ("HF_HUB_OFFLINE", "TRANSFORMERS_OFFLINE"))
+
+
+def hub_endpoint() -> str:
+    return os.environ.get("HF_ENDPOINT", "").rstrip("/") or "https://huggingface.co"
+
+
+def hub_reachable(timeout: float = HUB_PROBE_TIMEOUT_S) -> bool:
+    """One HTTP request to the hub endpoint, no retries: any HTTP answer within ``timeout`` counts."""
+    import urllib.error
+    import urllib.request
+
+    answered: list[bool] = []
+
+    def probe() -> None:
+        try:
+            urllib.request.urlopen(urllib.request.Request(hub_endpoint() + "/api/whoami-v2", method="HEAD"),
+                                   timeout=timeout).close()
+            answered.append(True)
+        except urllib.error.HTTPError:
+            answered.append(True)  # 401/404: the hub is there
+        except Exception:  # noqa: BLE001 - unreachable, refused, DNS, TLS: not reachable
+            answered.append(False)
+
+    t = threading.Thread(target=probe, daemon=True)  # DNS resolution has no timeout of its own
+    t.start()
+    t.join(timeout + 1.0)
+    return bool(answered and answered[0])
+
+
+def check_models_available(needs: list[ModelNeed]) -> None:
+    """Fail in seconds, with one line naming every missing model, when the weights are neither here nor
+    downloadable now (HF_HUB_OFFLINE set, or the hub does not answer a single short probe)."""
+    missing = [n for n in needs if not locally_available(n.model_id)]
+    if not missing:
+        return
+    if any(_looks_like_path(n.model_id) or Path(n.model_id).expanduser().exists() for n in missing):
+        why = "a configured local folder does not exist" + (", and HF_HUB_OFFLINE=1 is set" if hub_offline() else "")
+    elif hub_offline():
+        why = "HF_HUB_OFFLINE=1 is set, so nothing is downloaded"
+    elif not hub_reachable():
+        why = f"the model hub {hub_endpoint()} did not answer within {HUB_PROBE_TIMEOUT_S:.0f} s"
+    else:
+        log.warning("downloading %s from %s", ", ".join(n.model_id for n in missing), hub_endpoint())
+        return
+    names = "; ".join(f"{n.what} {n.model_id!r} (perception.{n.config_field})" for n in missing)
+    ids = " ".join(n.model_id for n in missing if not _looks_like_path(n.model_id))
+    raise ModelUnavailableError(
+        f"model weights not available on this machine ({why}): {names}. Fix: "
+        + (f"`huggingface-cli download {ids}` (each id) on a machine with internet and copy the cache "
+           f"($HF_HOME, default ~/.cache/huggingface), or " if ids else "")
+        + "save each model with save_pretrained() to a folder and set the perception field to that path.")
+
+
+def api_key(env_vars: tuple[str, ...], secret_block_var: str) -> str | None:
+    """An endpoint's key: the first of ``env_vars`` that is set, else the Prefect Secret block named by
+    ``$secret_block_var``. Never from the config: endpoints are recorded in scene.json and run parameters."""
+    for var in env_vars:
+        if os.environ.get(var):
+            return os.environ[var]
+    block = os.environ.get(secret_block_var)
+    if not block:
+        return None
+    try:
+        from prefect.blocks.system import Secret
+
+        return str(Secret.load(block).get())
+    except Exception as exc:  # noqa: BLE001 - one line, whatever the server said
+        raise ConfigError(f"{secret_block_var}={block!r}: the Prefect Secret block could not be read "
+                          f"({type(exc).__name__}); create it with `prefect block create secret` or unset the variable") from None
+
