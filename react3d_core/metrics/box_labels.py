@@ -18,7 +18,14 @@ below), so a part there is neither a hit nor a miss.
 Label file (JSON)::
 
     {"image_size": [640, 480],
-     "frames": {"frame-000064": {"fronts": {"L1": [x0, y0, x1, y1], ...}, "ignore": [[x0, y0, x1, y1]]}}}
+     "frames": {"frame-000064": {"fronts": {"L1": [x0, y0, x1, y1], ...}, "ignore": [[x0, y0, x1, y1]],
+                                 "render_to_photo": [[a, b, tx], [c, d, ty]]}}}
+
+Boxes are drawn on the colour photo. Where the photo is not registered to the pose projection (7-Scenes:
+the poses are the depth camera's; the colour differs by a per-frame scale and shift), an optional 2x3
+affine ``render_to_photo`` (photo pixel = A [u, v, 1] of the pose-projection pixel) maps them into the
+pose projection on loading, so a part that exactly covers a front is not penalised for the sensor's
+misregistration.
 """
 
 from __future__ import annotations
@@ -43,6 +50,7 @@ class FrameLabels:
 
     fronts: dict[str, Box]
     ignore: tuple[Box, ...] = ()
+    render_to_photo: tuple[tuple[float, float, float], tuple[float, float, float]] | None = None
 
 
 @dataclass(frozen=True)
@@ -145,16 +153,40 @@ def box_cover(inner: Box, outer: Box) -> float:
     return float(max(iw, 0.0) * max(ih, 0.0) / area) if area > 0 else 0.0
 
 
-def load_box_labels(path: str | Path) -> BoxLabels:
-    """Read the label JSON (format in the module docstring); boxes must have x0 < x1 and y0 < y1."""
+def photo_box_to_projection(box: Box, render_to_photo: Any) -> Box:
+    """Map a box drawn on the photo into the pose projection: inverse affine of its 4 corners, then their box."""
+    A = np.vstack([np.asarray(render_to_photo, float).reshape(2, 3), [0.0, 0.0, 1.0]])
+    x0, y0, x1, y1 = box
+    corners = np.array([[x0, y0, 1], [x1, y0, 1], [x1, y1, 1], [x0, y1, 1]], float)
+    q = corners @ np.linalg.inv(A).T
+    return (float(q[:, 0].min()), float(q[:, 1].min()), float(q[:, 0].max()), float(q[:, 1].max()))
+
+
+def load_box_labels(path: str | Path, to_projection: bool = True) -> BoxLabels:
+    """Read the label JSON (format in the module docstring); boxes must have x0 < x1 and y0 < y1.
+
+    ``to_projection`` maps the boxes of frames that carry ``render_to_photo`` into the pose projection
+    (what the evaluation compares with); False keeps them exactly as drawn on the photo."""
     doc = json.loads(Path(path).read_text())
+    w, h = doc.get("image_size", (640, 480))
     frames: dict[str, FrameLabels] = {}
     for fid, fr in doc["frames"].items():
         fronts = {k: _check_box(v, f"{fid}/{k}") for k, v in fr.get("fronts", {}).items()}
         ignore = tuple(_check_box(b, f"{fid}/ignore") for b in fr.get("ignore", []))
-        frames[fid] = FrameLabels(fronts, ignore)
-    w, h = doc.get("image_size", (640, 480))
+        A = fr.get("render_to_photo")
+        if A is not None:
+            A = tuple(tuple(float(x) for x in row) for row in A)
+            if np.asarray(A).shape != (2, 3):
+                raise ValueError(f"{fid}/render_to_photo must be a 2x3 affine, got {fr['render_to_photo']}")
+            if to_projection:  # clipped like a part's projection: what lies outside the image is not seen
+                fronts = {k: _clip(photo_box_to_projection(b, A), w, h) for k, b in fronts.items()}
+                ignore = tuple(_clip(photo_box_to_projection(b, A), w, h) for b in ignore)
+        frames[fid] = FrameLabels(fronts, ignore, A)
     return BoxLabels(frames, (int(w), int(h)))
+
+
+def _clip(b: Box, width: int, height: int) -> Box:
+    return (max(b[0], 0.0), max(b[1], 0.0), min(b[2], width - 1.0), min(b[3], height - 1.0))
 
 
 def _check_box(b: Any, where: str) -> Box:

@@ -114,10 +114,26 @@ def test_load_box_labels_rejects_inverted_boxes(tmp_path):
 def test_shipped_redkitchen_labels_are_well_formed():
     from pathlib import Path
 
-    lab = load_box_labels(Path(__file__).resolve().parents[1] / "data" / "redkitchen_fronts.json")
-    assert lab.front_ids == ["B1", "B2", "B3", "B4", "L1", "L2", "L3", "R1", "R2"]
-    assert 6 <= len(lab.frames) <= 10
-    W, H = lab.image_size
-    for fl in lab.frames.values():
-        for b in list(fl.fronts.values()) + list(fl.ignore):
-            assert 0 <= b[0] < b[2] <= W and 0 <= b[1] < b[3] <= H
+    path = Path(__file__).resolve().parents[1] / "data" / "redkitchen_fronts.json"
+    for to_projection in (False, True):
+        lab = load_box_labels(path, to_projection=to_projection)
+        assert lab.front_ids == ["B1", "B2", "B3", "B4", "L1", "L2", "L3", "R1", "R2"]
+        assert 6 <= len(lab.frames) <= 10
+        W, H = lab.image_size
+        for fl in lab.frames.values():
+            assert fl.render_to_photo is not None
+            for b in list(fl.fronts.values()) + list(fl.ignore):
+                assert 0 <= b[0] < b[2] <= W and 0 <= b[1] < b[3] <= H
+
+
+def test_render_to_photo_affine_maps_boxes_into_the_projection(tmp_path):
+    # photo = 0.5 * render + (10, 20): a photo box (20, 30, 40, 50) is the render box (20, 20, 60, 60)
+    p = tmp_path / "l.json"
+    p.write_text(json.dumps({"image_size": [100, 100], "frames": {"f1": {
+        "fronts": {"A": [20, 30, 40, 50]}, "ignore": [[10, 20, 12, 22]], "render_to_photo": [[0.5, 0, 10], [0, 0.5, 20]]}}}))
+    lab = load_box_labels(p)
+    assert lab.frames["f1"].fronts["A"] == pytest.approx((20, 20, 60, 60))
+    assert lab.frames["f1"].ignore[0] == pytest.approx((0, 0, 4, 4))
+    p.write_text(p.read_text().replace("[10, 20, 12, 22]", "[0, 10, 12, 22]"))  # maps to x0 = -20: clipped to the image
+    assert load_box_labels(p).frames["f1"].ignore[0] == pytest.approx((0, 0, 4, 4))
+    assert load_box_labels(p, to_projection=False).frames["f1"].fronts["A"] == pytest.approx((20, 30, 40, 50))
