@@ -18,6 +18,7 @@ from react3d_core.data.frames import SceneInput
 from react3d_core.data.mesh import TriMesh, load_mesh
 from react3d_core.raster import Rasterizer
 from react3d_core.scene_io import load_scene
+from react3d_core.scene_io.scale import check_scale
 
 from .store import tree_fingerprint
 
@@ -42,9 +43,10 @@ def rasterizer(mesh_path: str) -> Rasterizer:
 
 
 def fingerprint_body(scene_path: str, frames_cfg: dict[str, Any]) -> dict[str, Any]:
-    """Load and validate the scene, select frames, hash its content (frames, mesh, GT)."""
+    """Load and validate the scene (units included), select frames, hash its content (frames, mesh, GT)."""
     t0 = time.perf_counter()
     scene = scene_input(scene_path, frames_cfg)
+    check_scale(scene, scan_mesh(str(scene.mesh_path)))  # a millimetre mesh otherwise gives 0 parts, rc 0
     sha = tree_fingerprint(scene_path, exclude=("report", "export"))
     return {
         "sha256": sha,

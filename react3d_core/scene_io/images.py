@@ -43,12 +43,32 @@ def _video(path: str) -> _Video:
     return _Video(Path(path))
 
 
+def check_jpeg_complete(path: Path) -> None:
+    """Raise when a JPEG lacks its end-of-image marker: libjpeg only warns on a truncated file and
+    returns an image whose missing rows are grey, which the stages would take for real pixels."""
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(2)
+            fh.seek(0, 2)
+            size = fh.tell()
+            fh.seek(max(0, size - 4096))
+            tail = fh.read()
+    except OSError as exc:
+        raise InputError(path, f"cannot read image ({exc.strerror})") from None
+    if head != b"\xff\xd8":
+        raise InputError(path, "not a JPEG file (no start-of-image marker)")
+    if b"\xff\xd9" not in tail.rstrip(b"\x00"):  # EOI; cameras may pad or append a little after it
+        raise InputError(path, f"truncated JPEG ({size} bytes, no end-of-image marker): re-extract or re-copy this frame")
+
+
 def read_rgb(ref: ImageRef) -> np.ndarray:
     """RGB uint8 (H, W, 3)."""
     if ref.kind == "mkv":
         return _video(str(ref.path)).read(int(ref.index or 0))
     if not ref.path.is_file():
         raise InputError(ref.path, "image file not found")
+    if ref.path.suffix.lower() in (".jpg", ".jpeg"):
+        check_jpeg_complete(ref.path)
     img = cv2.imread(str(ref.path), cv2.IMREAD_COLOR)
     if img is None:
         raise InputError(ref.path, "cannot decode image")
@@ -89,4 +109,18 @@ def frame_rgb(frame: Frame) -> np.ndarray:
 
 
 def frame_depth(frame: Frame) -> np.ndarray | None:
-    return None if frame.depth is None else read_depth(frame.depth, frame.depth_scale)
+    """The frame's depth in metres, checked against the size its intrinsics declare: a depth map of
+    another size would be read with the wrong K and give wrong cavity depths and limits."""
+    if frame.depth is None:
+        return None
+    d = read_depth(frame.depth, frame.depth_scale)
+    k = frame.depth_intrinsics
+    if k is not None and d.shape[:2] != (k.height, k.width):
+        raise InputError(frame.depth.path, depth_size_problem(frame.frame_id, d.shape[1], d.shape[0], k.width, k.height))
+    return d
+
+
+def depth_size_problem(frame_id: str, w: int, h: int, dw: int, dh: int) -> str:
+    """One line for a depth map whose size differs from the declared one."""
+    return (f"{frame_id}: depth image is {w}x{h} but the scan declares {dw}x{dh}; "
+            "re-export the depth at the declared size (react3d does not guess how it was resized)")

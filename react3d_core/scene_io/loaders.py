@@ -19,6 +19,7 @@ from ..config.frames import FrameSelectionConfig
 from ..data.frames import Frame, ImageRef, Intrinsics, SceneInput, validate_pose
 from ..errors import InputError
 from .depth_bin import DepthBin
+from .images import check_jpeg_complete, depth_size_problem
 from .selection import select_frames
 
 SCANNETPP_K_SIZE = (1920, 1440)
@@ -32,11 +33,31 @@ def _image_size(path: Path) -> tuple[int, int]:
         ok, img = cap.read()
         cap.release()
     else:
+        if path.suffix.lower() in (".jpg", ".jpeg"):
+            check_jpeg_complete(path)
         img = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
         ok = img is not None
     if not ok:
         raise InputError(path, "cannot decode image")
     return int(img.shape[1]), int(img.shape[0])
+
+
+def _png_size(path: Path) -> tuple[int, int] | None:
+    """(width, height) from a PNG's IHDR chunk (24 bytes read), None when it is not a PNG."""
+    with open(path, "rb") as fh:
+        head = fh.read(24)
+    if len(head) < 24 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        return None
+    return int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+
+
+def _check_depth_png(path: Path, frame_id: str, size: tuple[int, int]) -> None:
+    """Per frame, at load: a depth PNG must have the size the layout declares (256x192 for ScanNet++)."""
+    got = _png_size(path)
+    if got is None:
+        raise InputError(path, f"{frame_id}: not a PNG depth image")
+    if got != size:
+        raise InputError(path, depth_size_problem(frame_id, *got, *size))
 
 
 def _read_json(path: Path) -> dict:
@@ -150,10 +171,12 @@ def _load_iphone(root: Path) -> SceneInput:
             p = ip / "rgb" / f"{key}.jpg"
             if not p.is_file():
                 raise InputError(p, "image file not found")
+            check_jpeg_complete(p)  # per frame at load: 4 KB read; libjpeg would only warn later
             rgb = ImageRef(path=p, kind="jpg")
         if depth_kind:
             depth = ImageRef(path=depth_bin, kind=depth_kind, index=n)
         elif (ip / "depth" / f"{key}.png").is_file():
+            _check_depth_png(ip / "depth" / f"{key}.png", key, DEPTH_SIZE)
             depth = ImageRef(path=ip / "depth" / f"{key}.png", kind="png")
         else:
             depth = None
@@ -186,6 +209,8 @@ def _load_prepared(root: Path) -> SceneInput:
         entry = meta[key]
         K = _intrinsics(meta_path, key, entry["intrinsic"], *SCANNETPP_K_SIZE).scaled(*size)
         d = root / "depth" / f"{key}.png"
+        if d.is_file():
+            _check_depth_png(d, key, DEPTH_SIZE)
         frames.append(Frame(frame_id=key, rgb=ImageRef(path=p, kind="png"),
                             depth=ImageRef(path=d, kind="png") if d.is_file() else None,
                             intrinsics=K, depth_intrinsics=K.scaled(*DEPTH_SIZE) if d.is_file() else None,
@@ -227,6 +252,8 @@ def _load_generic(root: Path, scannetpp_world: bool | None = None) -> SceneInput
             dref = ImageRef(path=dp, kind="npy" if dp.suffix == ".npy" else "png")
             dK = base.scaled(*_image_size(dp)) if dp.suffix != ".npy" else base
         kind = "png" if p.suffix.lower() == ".png" else "jpg"
+        if p.suffix.lower() in (".jpg", ".jpeg"):
+            check_jpeg_complete(p)
         frames.append(Frame(frame_id=p.stem, rgb=ImageRef(path=p, kind=kind), depth=dref, intrinsics=base,
                             depth_intrinsics=dK, pose=c2w))
     if not frames:
