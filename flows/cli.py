@@ -4,6 +4,7 @@ so ``react3d inspect`` does not import Prefect or torch."""
 from __future__ import annotations
 
 import argparse
+import errno
 import importlib
 import os
 import sys
@@ -53,16 +54,67 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     from react3d_core.errors import React3DError
 
+    debug = args.verbose or bool(os.environ.get("REACT3D_DEBUG"))
     try:
         return int(args._run(args) or 0)
     except React3DError as exc:
-        if args.verbose or os.environ.get("REACT3D_DEBUG"):
+        if debug:
             raise
-        print(f"react3d {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return _fail(args.command, str(exc), 2, details=len(str(exc).strip().splitlines()) > 1)
+    except OSError as exc:
+        if debug or exc.errno not in _WRITE_ERRNOS:
+            raise
+        # read-only output, disk full: the raw error was a traceback (disk full: one 642 KB line)
+        where = exc.filename or "output"
+        hint = "free some space or choose an --out on another disk" if exc.errno in (errno.ENOSPC, errno.EDQUOT) \
+            else "choose an --out folder you can write to"
+        return _fail(args.command, f"{where}: {exc.strerror}; {hint}", 2 if exc.errno in _BAD_INPUT_ERRNOS else 1,
+                     details=True)
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
         return 130
+
+
+_WRITE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM}
+_BAD_INPUT_ERRNOS = {errno.EROFS, errno.EACCES, errno.EPERM}  # the user chose an --out that cannot be written
+
+
+def _fail(command: str, message: str, rc: int, details: bool) -> int:
+    """Print one line (what, which file, what to do) first; with ``details`` the full message and the
+    traceback go to a log file named on that line."""
+    lines = message.strip().splitlines() or ["failed"]
+    line = lines[0][:400]
+    log = _write_log(command, message) if details else None
+    print(f"react3d {command}: error: {line}" + (f"  (details: {log})" if log else ""), file=sys.stderr)
+    return rc
+
+
+_LOG_PATH: list[str] = []
+
+
+def log_path() -> str:
+    """This process's details log: ``$REACT3D_LOG_DIR`` (default: the temporary folder), created only
+    when something is written to it (a failure's traceback, Prefect's error records)."""
+    if not _LOG_PATH:
+        import tempfile
+        import time
+
+        folder = os.environ.get("REACT3D_LOG_DIR") or tempfile.gettempdir()
+        _LOG_PATH.append(os.path.join(folder, f"react3d-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.log"))
+    return _LOG_PATH[0]
+
+
+def _write_log(command: str, message: str) -> str | None:
+    """Append the details of a failure to :func:`log_path`; None if it cannot be written."""
+    import traceback
+
+    path = log_path()
+    try:
+        with open(path, "a", encoding="utf-8") as fh:
+            fh.write(f"react3d {command}: {' '.join(sys.argv)}\n{message}\n\n{traceback.format_exc()}")
+    except OSError:
+        return None
+    return path
 
 
 if __name__ == "__main__":

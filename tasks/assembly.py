@@ -106,11 +106,26 @@ def fill_output(result: dict[str, Any], staging: str | Path, out_dir: str | Path
     manifest = InteractiveScene.load(src / "scene.json")
     mesh = Path(scan_mesh_path) if scan_mesh_path else Path(manifest.input_mesh)
     mesh = mesh.resolve() if mesh.is_absolute() or scan_mesh_path else (src / mesh).resolve()
-    shutil.copytree(src, staging, dirs_exist_ok=True)
+    _copy_tree(src, staging)
     # the scan mesh stays where it is: re-point the manifest's reference from the new folder
     rel = os.path.relpath(mesh, out.resolve())
     manifest.model_copy(update={"input_mesh": rel}).save(staging / "scene.json")
     return str(staging / "scene.json")
+
+
+def _copy_tree(src: Path, dst: Path) -> None:
+    """Copy ``src`` into ``dst``, stopping at the first failure with one OSError naming the target file
+    (``shutil.copytree`` collects every failed file into one exception: 642 KB for a full disk)."""
+    for p in sorted(src.rglob("*")):
+        target = dst / p.relative_to(src)
+        try:
+            if p.is_dir():
+                target.mkdir(parents=True, exist_ok=True)
+            else:
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(p, target)
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, str(target)) from None
 
 
 def publish_body(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None,

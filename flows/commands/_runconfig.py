@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -31,6 +33,11 @@ def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
             raise ConfigError(f"{text}: config file not found") from None
         except json.JSONDecodeError as exc:
             raise ConfigError(f"{text}: not valid JSON ({exc})") from None
+        except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+            raise ConfigError(f"{text}: cannot read the config file ({exc.__class__.__name__})") from None
+        if not isinstance(cfg, dict):
+            raise ConfigError(f"{text}: the config must be a JSON object ({{\"section\": {{...}}}}), "
+                              f"not a {type(cfg).__name__}")
     def put(path: tuple[str, ...], value: Any) -> None:
         d = cfg
         for k in path[:-1]:
@@ -40,16 +47,83 @@ def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
         put(("perception", "backend"), args.perception)
     if args.no_refine:
         put(("articulation", "refine"), False)
-    if args.stride:
+    for flag, value in (("--stride", args.stride), ("--max-frames", args.max_frames)):
+        if value is not None and value < 1:  # 0 used to be ignored silently
+            raise ConfigError(f"{flag} must be at least 1, got {value}")
+    if args.stride is not None:
         put(("frames", "stride"), args.stride)
-    if args.max_frames:
+    if args.max_frames is not None:
         put(("frames", "max_frames"), args.max_frames)
     if args.formats:
-        put(("export", "formats"), [f.strip() for f in args.formats.split(",") if f.strip() and f.strip() != "none"])
+        formats = [f.strip().lower() for f in args.formats.split(",") if f.strip() and f.strip().lower() != "none"]
+        put(("export", "formats"), formats)
+    _check_formats(cfg.get("export", {}).get("formats", []) if isinstance(cfg.get("export"), dict) else [])
     from react3d_core.config import PipelineConfig
 
     PipelineConfig().with_overrides(cfg)  # validate now: one clear error before Prefect starts
     return cfg
+
+
+def precheck_scene(scene: str, cfg: dict[str, Any]) -> None:
+    """Load and validate the scan (frames, depth sizes, JPEGs, units) before Prefect starts, so bad input
+    gives one line and no Prefect logs; the flow then reuses what was loaded (per-process caches)."""
+    from tasks import prefect_env
+
+    prefect_env.configure()
+    from react3d_core.config import PipelineConfig
+    from react3d_core.scene_io.scale import check_scale
+    from tasks.scene import scan_mesh, scene_input
+
+    frames_cfg = PipelineConfig().with_overrides(cfg).model_dump(mode="json")["frames"]
+    loaded = scene_input(scene, frames_cfg)
+    check_scale(loaded, scan_mesh(str(loaded.mesh_path)))
+
+
+def _check_formats(formats: object) -> None:
+    """Unknown export formats used to fail only at the export stage, minutes in, with a traceback."""
+    from react3d_core.export.scene import FORMATS
+
+    bad = [f for f in formats if f not in FORMATS] if isinstance(formats, (list, tuple)) else [formats]
+    if bad:
+        raise ConfigError(f"unknown export format(s) {', '.join(map(str, bad))}: choose from {', '.join(FORMATS)} or none")
+
+
+@contextlib.contextmanager
+def prefect_errors_to_log(path: str) -> Iterator[None]:
+    """Prefect reports a failed task or flow as ERROR records with tracebacks on the console (84-113
+    lines before the one that says what to do); during a CLI run they go to the log file ``path``
+    instead and the CLI prints one line naming it. Warnings still reach the console."""
+    import logging
+
+    class _NoPrefectErrors(logging.Filter):
+        def filter(self, record: logging.LogRecord) -> bool:
+            return not (record.levelno >= logging.ERROR and record.name.startswith("prefect"))
+
+    file_handler = logging.FileHandler(path, delay=True, encoding="utf-8")
+    file_handler.setLevel(logging.ERROR)
+    file_handler.setFormatter(logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s"))
+    from prefect.logging.configuration import ensure_logging_setup
+
+    ensure_logging_setup()  # Prefect configures logging lazily; its console handler sits on the root logger
+    drop = _NoPrefectErrors()
+    names = [n for n in logging.Logger.manager.loggerDict if n == "prefect" or n.startswith("prefect.")]
+    touched: list[tuple[logging.Logger, list[logging.Handler]]] = []
+    for logger in [logging.getLogger()] + [logging.getLogger(n) for n in names]:
+        consoles = [h for h in logger.handlers
+                    if isinstance(h, logging.StreamHandler) and not isinstance(h, logging.FileHandler)]
+        if consoles:
+            for h in consoles:
+                h.addFilter(drop)
+            logger.addHandler(file_handler)
+            touched.append((logger, consoles))
+    try:
+        yield
+    finally:
+        for logger, consoles in touched:
+            for h in consoles:
+                h.removeFilter(drop)
+            logger.removeHandler(file_handler)
+        file_handler.close()
 
 
 def run_with_progress(scene: str, out: str, cfg: dict[str, Any], title: str) -> str:
@@ -72,7 +146,10 @@ def run_with_progress(scene: str, out: str, cfg: dict[str, Any], title: str) -> 
 
         bar.console.print(f"[dim]{title}[/dim]")
         cs.PROGRESS_HOOK = hook
+        from flows.cli import log_path
+
         try:
-            return cs.convert_scene(scene, out, cfg)
+            with prefect_errors_to_log(log_path()):
+                return cs.convert_scene(scene, out, cfg)
         finally:
             cs.PROGRESS_HOOK = None

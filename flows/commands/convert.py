@@ -18,13 +18,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from rich.console import Console
 
-    from ._runconfig import pipeline_overrides, run_with_progress
+    from ._runconfig import pipeline_overrides, precheck_scene, run_with_progress
     from .summary import print_summary
 
     from react3d_core.atomic import check_output_dir
 
     cfg = pipeline_overrides(args)
     check_output_dir(args.out, (args.scene,), kind="scene")  # before Prefect starts: one line, nothing touched
+    precheck_scene(args.scene, cfg)
     manifest = run_with_progress(args.scene, args.out, cfg, f"converting {args.scene}")
     print_summary(Console(), manifest)
     return 0
