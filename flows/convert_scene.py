@@ -31,6 +31,9 @@ from tasks.scene import fingerprint_scene  # noqa: E402
 from tasks.segmentation import segment_scene  # noqa: E402
 
 from .artifacts import publish_scene_artifacts, Progress  # noqa: E402
+from .server_watchdog import install as _install_server_watchdog  # noqa: E402
+
+_install_server_watchdog()  # Prefect's temporary server ends with this process, even after kill -9
 
 STAGE_MODULES = ("react3d_core.scene_io", "react3d_core.perception", "react3d_core.perception.heuristic",
                  "react3d_core.perception.oracle", "react3d_core.fusion", "react3d_core.articulation",
