@@ -83,7 +83,8 @@ class PredictedPart:
 
 @dataclass
 class FrontResult:
-    """Outcome for one labelled front."""
+    """Outcome for one labelled front: the part the one-to-one matching gave it (if any overlaps), its mean box
+    IoU, its best IoU with any other front (a merged part scores on two), and ``found`` = IoU >= threshold."""
 
     front_id: str
     found: bool
@@ -215,33 +216,38 @@ def load_predicted_parts(result_dir: str | Path, max_vertices: int = 20000) -> l
     return parts
 
 
-def visible_box(vertices: np.ndarray, frame: Frame, depth: np.ndarray | None, depth_tol: float = 0.03,
-                min_visible: int = 20, width: int | None = None, height: int | None = None) -> Box | None:
-    """Box of the projection of ``vertices`` that the camera of ``frame`` actually sees, or None.
+def project_visible(vertices: np.ndarray, frame: Frame, depth: np.ndarray | None, depth_tol: float = 0.03,
+                    width: int | None = None, height: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel coordinates (N, 2) of ``vertices`` in ``frame`` and which of them the camera sees.
 
-    A vertex counts when it projects inside the image, lies in front of the camera, and is not behind the
-    rendered scan surface ``depth`` (z-depth, 0 = no surface) by more than ``depth_tol`` metres; fewer than
-    ``min_visible`` such vertices means the part is not visible. ``depth=None`` skips the occlusion test."""
+    Seen: in front of the camera, inside the image, and not behind the rendered scan surface ``depth``
+    (z-depth, 0 = no surface) by more than ``depth_tol`` metres; ``depth=None`` skips the occlusion test."""
     intr = frame.intrinsics
     W, H = width or intr.width, height or intr.height
     K = intr.scaled(W, H).K if (W, H) != (intr.width, intr.height) else intr.K
     w2c = frame.w2c
-    pc = np.asarray(vertices, float) @ w2c[:3, :3].T + w2c[:3, 3]
+    pc = np.asarray(vertices, float).reshape(-1, 3) @ w2c[:3, :3].T + w2c[:3, 3]
     z = pc[:, 2]
     front = z > 1e-3
-    pc, z = pc[front], z[front]
-    u = K[0, 0] * pc[:, 0] / z + K[0, 2]
-    v = K[1, 1] * pc[:, 1] / z + K[1, 2]
-    ui, vi = np.rint(u).astype(np.int64), np.rint(v).astype(np.int64)
-    inside = (ui >= 0) & (ui < W) & (vi >= 0) & (vi < H)
-    u, v, z, ui, vi = u[inside], v[inside], z[inside], ui[inside], vi[inside]
+    zs = np.where(front, z, 1.0)
+    uv = np.stack([K[0, 0] * pc[:, 0] / zs + K[0, 2], K[1, 1] * pc[:, 1] / zs + K[1, 2]], -1)
+    ui, vi = np.rint(uv[:, 0]).astype(np.int64), np.rint(uv[:, 1]).astype(np.int64)
+    seen = front & (ui >= 0) & (ui < W) & (vi >= 0) & (vi < H)
     if depth is not None:
-        d = depth[vi, ui]
-        keep = (d <= 0) | (z <= d + depth_tol)
-        u, v = u[keep], v[keep]
-    if len(u) < min_visible:
+        d = depth[vi[seen], ui[seen]]
+        seen[seen] = (d <= 0) | (z[seen] <= d + depth_tol)
+    return uv, seen
+
+
+def visible_box(vertices: np.ndarray, frame: Frame, depth: np.ndarray | None, depth_tol: float = 0.03,
+                min_visible: int = 20, width: int | None = None, height: int | None = None) -> Box | None:
+    """Box of the projection of ``vertices`` that the camera of ``frame`` actually sees (``project_visible``),
+    or None when fewer than ``min_visible`` vertices are seen."""
+    uv, seen = project_visible(vertices, frame, depth, depth_tol, width, height)
+    if int(seen.sum()) < min_visible:
         return None
-    return (float(u.min()), float(v.min()), float(u.max()), float(v.max()))
+    q = uv[seen]
+    return (float(q[:, 0].min()), float(q[:, 1].min()), float(q[:, 0].max()), float(q[:, 1].max()))
 
 
 def part_boxes(parts: list[PredictedPart], scene: SceneInput, labels: BoxLabels, scan: TriMesh | None = None,
@@ -279,17 +285,17 @@ def match_boxes(boxes: dict[str, dict[str, Box | None]], labels: BoxLabels,
             ious = {fid: box_iou(boxes[pid].get(fid), labels.frames[fid].fronts[f]) for fid in labelled_in[f]}
             per_frame[i, j] = ious
             S[i, j] = float(np.mean(list(ious.values()))) if ious else 0.0
-    matched: dict[int, int] = {}
+    assigned: dict[int, int] = {}
     if S.size:
         rows, cols = linear_sum_assignment(-S)
-        matched = {int(c): int(r) for r, c in zip(rows, cols) if S[r, c] >= iou_threshold}
+        assigned = {int(c): int(r) for r, c in zip(rows, cols) if S[r, c] > 0}
+    matched = {j: i for j, i in assigned.items() if S[i, j] >= iou_threshold}
     fronts = []
     for j, f in enumerate(front_ids):
-        if j in matched:
-            i = matched[j]
+        if j in assigned:  # below the threshold the assigned part is still reported (found=False) for diagnosis
+            i = assigned[j]
             other = float(np.delete(S[i], j).max()) if len(front_ids) > 1 else 0.0
-            p = part_ids[i]
-            fronts.append(FrontResult(f, True, p, float(S[i, j]), other, per_frame_iou=per_frame[i, j]))
+            fronts.append(FrontResult(f, j in matched, part_ids[i], float(S[i, j]), other, per_frame_iou=per_frame[i, j]))
         else:
             fronts.append(FrontResult(f, False))
     found_parts = {part_ids[i] for i in matched.values()}
@@ -319,7 +325,7 @@ def evaluate_box_labels(result_dir: str | Path, scene: SceneInput, labels: BoxLa
     boxes = part_boxes(parts, scene, labels, depth_tol=depth_tol, min_visible=min_visible)
     report = match_boxes(boxes, labels, iou_threshold, ignore_cover)
     by_id = {p.object_id: p for p in parts}
-    for fr in report.fronts:
+    for fr in report.fronts:  # joints of every assigned part, found or not
         if fr.part is not None:
             fr.joint_type = by_id[fr.part].joint_type
             fr.joint_class = by_id[fr.part].joint_class

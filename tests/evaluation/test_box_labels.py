@@ -61,6 +61,8 @@ def test_part_missing_in_a_labelled_frame_scores_zero_there():
     assert a.found and a.iou == pytest.approx(0.5) and a.per_frame_iou == {"f1": 1.0, "f2": 0.0}
     r = match_boxes({"p": {"f1": (0, 0, 10, 10), "f2": None}}, _labels(), iou_threshold=0.51)
     assert r.n_found == 0 and r.false_parts == ["p"]
+    a = next(f for f in r.fronts if f.front_id == "A")
+    assert not a.found and a.part == "p" and a.iou == pytest.approx(0.5)  # still reported, for diagnosis
 
 
 def test_merged_part_reports_its_iou_with_the_other_front():
