@@ -19,6 +19,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
     from rich.console import Console
     from rich.table import Table
 
@@ -34,7 +36,13 @@ def run(args: argparse.Namespace) -> int:
     cfg = pipeline_overrides(args)
     check_dataset_outputs(args.root, args.scenes, args.glob, args.out)  # before any scene runs
     console = Console()
-    with console.status("converting scenes (per-scene progress in the Prefect UI when a server is configured)"):
+    from flows.cli import log_path
+
+    from ._runconfig import prefect_errors_to_log
+
+    # a failed scene is one row of the table below; Prefect's tracebacks for it go to the log file
+    with console.status("converting scenes (per-scene progress in the Prefect UI when a server is configured)"), \
+            prefect_errors_to_log(log_path()):
         rows = convert_dataset(args.root, args.scenes, args.glob, args.out, cfg, args.concurrency)
     t = Table(title=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
     for c in ("scene", "status", "parts", "seconds", "error"):
@@ -43,4 +51,6 @@ def run(args: argparse.Namespace) -> int:
         t.add_row(r["scene"], "[green]ok[/green]" if r["status"] == "ok" else "[red]failed[/red]", str(r["parts"]),
                   f"{r['seconds']:.1f}", r["error"])
     console.print(t)
+    if Path(log_path()).is_file():
+        console.print(f"details of the failures: {log_path()}")
     return 0 if all(r["status"] == "ok" for r in rows) else 1

@@ -63,3 +63,17 @@ def test_read_only_output_is_refused_before_anything_runs(small_fs: Path, scan: 
     assert r.returncode == 2, r.stderr[-2000:]
     assert first_line(r.stderr).startswith(f"react3d convert: error: {small_fs / 'out'}: is not writable"), r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and snapshot(small_fs) == before
+
+
+def test_dataset_failure_is_a_table_row_not_tracebacks(scan: Path, cli_env: dict, tmp_path: Path) -> None:
+    root = tmp_path / "data"
+    shutil.copytree(scan, root / "good")
+    shutil.copytree(scan, root / "broken")
+    (root / "broken" / "scans" / "mesh_aligned_0.05.ply").write_bytes(b"ply\nformat ascii 1.0\nelement vertex 3\n")
+    env = {**cli_env, "REACT3D_LOG_DIR": str(tmp_path), "COLUMNS": "250"}
+    r = run_cli(["convert-dataset", str(root), "--out", str(tmp_path / "out"), *FAST], env)
+    assert r.returncode == 1, r.stderr[-3000:]
+    assert "Traceback" not in r.stderr and "ERROR" not in r.stderr, r.stderr[-3000:]
+    assert "1/2 scenes converted" in r.stdout and "mesh_aligned_0.05.ply" in r.stdout, r.stdout[-3000:]
+    assert "details of the failures: " in r.stdout
+    assert (tmp_path / "out" / "good" / "scene.json").is_file() and not (tmp_path / "out" / "broken").exists()
