@@ -24,9 +24,14 @@ def run(args: argparse.Namespace) -> int:
     from ._runconfig import run_with_progress
     from .summary import print_summary
 
+    from react3d_core.atomic import check_output_dir
+
     console = Console()
     out = Path(args.out)
     scene = out / "scene"
+    if not (scene / "synth_meta.json").exists():
+        check_output_dir(scene, kind="synth")  # a folder of the user's named demo_out/scene is never replaced
+    check_output_dir(out / "result", (scene,), kind="scene")
     if not (scene / "synth_meta.json").exists():
         with console.status("generating the demo scene (synthetic kitchen with ground truth)"):
             demo_scene(scene)

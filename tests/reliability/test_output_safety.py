@@ -95,3 +95,12 @@ def test_previous_output_is_replaced_whole_and_marked(converted: Path, scan: Pat
     assert (out / "report.html").stat().st_size > 10_000 and (out / "metrics.json").is_file()
     assert not (out / "meshes" / "stale.ply").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no .out.old-PID / .out.tmp-* left
+
+
+def test_demo_refuses_a_users_folder_where_its_scene_goes(cli_env: dict, tmp_path: Path) -> None:
+    (tmp_path / "demo_out" / "scene").mkdir(parents=True)
+    (tmp_path / "demo_out" / "scene" / "notes.txt").write_text("mine")
+    before = snapshot(tmp_path)
+    r = run_cli(["demo", "--out", str(tmp_path / "demo_out")], cli_env, timeout=120)
+    _refused(r, "demo", tmp_path / "demo_out" / "scene", "is not a react3d output")
+    assert snapshot(tmp_path) == before
