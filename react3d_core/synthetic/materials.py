@@ -7,8 +7,8 @@ renderer adds what real captures have, all vectorized over the hit pixels:
   same grain), glossy single colours and metal handles with Blinn-Phong highlights of the room lights
   plus a Fresnel-weighted reflection of the room (view-dependent: highlights move between views),
   matte paint with a faint roller texture, speckled stone worktops;
-- light falloff: point lights on the ceiling and one low "window" light, intensity ~ 1/r^2, and
-  lens vignetting;
+- light falloff: point lights on the ceiling and a lamp at 1.3 m, intensity ~ 1/r^2, and lens
+  vignetting;
 - crevice darkening: a pixel lying behind the planes of the surfaces on *both* sides of it (the 4 mm
   gap between two fronts, seen edge-on) is darkened like the ambient occlusion that makes real seams
   show as thin dark lines;
@@ -52,11 +52,12 @@ class PhotoSettings:
 
 
 def scene_lights(room: tuple[float, float, float]) -> np.ndarray:
-    """Two ceiling lights and a low light near the wall at y = 0 (a window), for a W x L x H room."""
+    """Two ceiling lights and a weaker lamp at 1.3 m in the middle of a W x L x H room (its low
+    position puts highlights on base-cabinet fronts; lights near a wall would blow it out)."""
     W, L, H = room
     return np.array([[0.3 * W, 0.4 * L, H - 0.05, 1.0],
                      [0.7 * W, 0.6 * L, H - 0.05, 1.0],
-                     [0.5 * W, 0.3, 1.0, 0.7]], np.float32)
+                     [0.5 * W, 0.5 * L, 1.3, 0.5]], np.float32)
 
 
 _TEX_SIZE = 512
@@ -215,7 +216,7 @@ def render_photo(hit: dict[str, np.ndarray], faces: np.ndarray, colors: np.ndarr
         L = np.array([lx, ly, lz], np.float32)[:, None, None] - p
         r2 = _dot(L, L)
         l = L / np.sqrt(r2)
-        diffuse += 0.6 * np.clip(_dot(n, l), 0.0, None) * (power * 2.2 / (r2 + 0.4))
+        diffuse += 0.6 * np.clip(_dot(n, l), 0.0, None) * (power * 2.5 / (r2 + 0.8))
         h = l + vdir
         h /= np.sqrt(_dot(h, h)) + 1e-9
         ndh = np.clip(_dot(n, h), 0.0, 1.0)
