@@ -49,7 +49,7 @@ def put(obj: Any, kind: str) -> dict[str, str]:
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
-    _remember(path, sha)
+    _remember(path)
     return {"sha256": sha, "path": str(path), "kind": kind}
 
 
@@ -81,7 +81,7 @@ def _read_verified(path: Path, sha: str) -> bytes:
         quarantine(path, "its bytes do not match its sha256")
         raise CorruptObjectError(path, "cached object was corrupt (sha256 mismatch) and has been quarantined; "
                                        "run the command again to recompute it")
-    _remember(path, sha)
+    _remember(path)
     return data
 
 
@@ -113,7 +113,7 @@ def _stat_sig(path: Path) -> tuple[int, int, int]:
     return (st.st_size, st.st_mtime_ns, st.st_ino)
 
 
-def _remember(path: Path, _sha: str | None = None) -> None:
+def _remember(path: Path) -> None:
     try:
         _verified[str(path)] = _signature(path)
     except OSError:
