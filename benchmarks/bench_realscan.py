@@ -4,8 +4,9 @@
         [--perception heuristic] [--stride N] [--json benchmarks/results/redkitchen.json]
 
 The scan has no 3D ground truth; ``tests/data/redkitchen_fronts.json`` holds 2D boxes of its 9 clearly
-visible fronts in a few colour frames (drawn by hand). ``react3d convert`` runs as its own process (what
-a user runs), timed end to end (wall) with the peak resident memory of its process tree sampled every
+visible fronts in a few colour frames (drawn by hand). ``react3d convert`` runs as its own process (``python -m
+flows.cli convert`` from the checkout holding this script, so a clean export of a commit benchmarks that
+commit), timed end to end (wall) with the peak resident memory of its process tree sampled every
 0.2 s (and the largest single process from the kernel's rusage). The result folder is then scored with
 ``react3d_core.metrics.box_labels`` (occlusion-aware projection of every part, Hungarian matching, a
 front is found at mean box IoU >= 0.5). The scan itself is read from outside the repository and never
@@ -62,9 +63,7 @@ def run_convert(scene: Path, out: Path, perception: str = "heuristic", stride: i
     cmd = [sys.executable, "-m", "flows.cli", "convert", str(scene), "--out", str(out), "--perception", perception]
     if stride is not None:
         cmd += ["--stride", str(stride)]
-    cmd += list(extra or [])
-    if shutil.which("react3d"):
-        cmd = ["react3d", *cmd[3:]]
+    cmd += list(extra or [])  # `python -m flows.cli` from this checkout: the code benchmarked is the tree the script is in
     peak = [0]
     t0 = time.perf_counter()
     env = dict(os.environ)
@@ -119,6 +118,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--perception", default="heuristic")
     ap.add_argument("--stride", type=int, default=None, help="use every n-th frame (default: the config's)")
     ap.add_argument("--iou", type=float, default=0.5, help="box IoU for a front to count as found")
+    ap.add_argument("--note", default="", help="free text stored in the JSON (e.g. which commit an export holds)")
     ap.add_argument("--warm-cache", action="store_true", help="keep the user's task cache (default: an empty one)")
     ap.add_argument("--skip-convert", action="store_true", help="score an existing --out folder only")
     ap.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "results" / "redkitchen.json")
@@ -130,7 +130,8 @@ def main(argv: list[str] | None = None) -> int:
     from react3d_core.metrics.box_labels import evaluate_box_labels
     from react3d_core.scene_io import load_scene
 
-    result: dict[str, Any] = {"scene": args.scene.name, "perception": args.perception, "stride": args.stride,
+    result: dict[str, Any] = {"scene": args.scene.name, "perception": args.perception, "stride": args.stride, "note": args.note,
+                              "source": _git_state(),
                               "machine": {"python": platform.python_version(), "cpus": _cpus(),
                                           "load_avg_1m_before": round(os.getloadavg()[0], 2)}}
     if not args.skip_convert:
@@ -160,6 +161,17 @@ def main(argv: list[str] | None = None) -> int:
     _write(args.json, result)
     print(f"wrote {args.json}")
     return 0
+
+
+def _git_state() -> dict[str, Any]:
+    """Commit of the benchmarked checkout and whether it had local changes (a benchmark of a dirty tree is not a commit's)."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=ROOT, capture_output=True, text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=ROOT, capture_output=True,
+                               text=True, check=True).stdout.strip()
+        return {"commit": head, "modified_files": len(dirty.splitlines())}
+    except (OSError, subprocess.CalledProcessError):
+        return {"commit": None, "modified_files": None}
 
 
 def _cpus() -> int:
