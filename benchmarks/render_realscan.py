@@ -32,8 +32,9 @@ from react3d_core.raster import Rasterizer  # noqa: E402
 DEFAULT_SCENE = (ROOT / ".." / "shared" / "data" / "redkitchen").resolve()
 DEFAULT_LABELS = ROOT / "tests" / "data" / "redkitchen_fronts.json"
 DEFAULT_FRAMES = ("frame-000120", "frame-000700", "frame-000868")
-PALETTE = [(230, 25, 75), (60, 180, 75), (255, 225, 25), (0, 130, 200), (245, 130, 48), (145, 30, 180),
-           (70, 240, 240), (240, 50, 230), (210, 245, 60), (0, 128, 128), (170, 110, 40), (128, 0, 0)]  # RGB
+# RGB, no reds: the RedKitchen fronts are red and a red tint would vanish on them
+PALETTE = [(0, 130, 200), (60, 180, 75), (255, 225, 25), (145, 30, 180), (70, 240, 240), (245, 130, 48),
+           (210, 245, 60), (0, 128, 128), (240, 50, 230), (170, 110, 40), (0, 0, 128), (170, 255, 195)]
 SHORT = {"revolute_vertical": "rev-V", "revolute_horizontal": "rev-H", "prismatic": "pris"}
 
 
@@ -65,7 +66,7 @@ def tint_parts(img: np.ndarray, depth: np.ndarray, frame: Frame, parts: list[tup
         c = np.array(PALETTE[k % len(PALETTE)], float)
         img[vis] = (img[vis] * (1 - alpha) + c * alpha).astype(np.uint8)
         ys, xs = np.nonzero(vis)
-        _text(img, f"{pid} {SHORT.get(joint, joint)}", (int(xs.mean()) - 40, int(ys.mean())), tuple(int(v) for v in c))
+        _text(img, f"{pid} {SHORT.get(joint, joint)}", (int(xs.mean()) - 40, int(ys.mean())), (255, 255, 255))
 
 
 def draw_boxes(img: np.ndarray, labels: BoxLabels, frame_id: str, report: BoxLabelReport | None) -> None:
@@ -83,7 +84,8 @@ def draw_boxes(img: np.ndarray, labels: BoxLabels, frame_id: str, report: BoxLab
 
 
 def _text(img: np.ndarray, s: str, org: tuple[int, int], col: tuple[int, int, int]) -> None:
-    cv2.putText(img, s, org, cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 3, cv2.LINE_AA)
+    for dx, dy in ((-1, 0), (1, 0), (0, -1), (0, 1)):  # a 1 px outline (a thicker stroke would widen the glyphs)
+        cv2.putText(img, s, (org[0] + dx, org[1] + dy), cv2.FONT_HERSHEY_SIMPLEX, 0.5, (0, 0, 0), 1, cv2.LINE_AA)
     cv2.putText(img, s, org, cv2.FONT_HERSHEY_SIMPLEX, 0.5, col, 1, cv2.LINE_AA)
 
 
@@ -119,7 +121,7 @@ def main(argv: list[str] | None = None) -> int:
         tint_parts(img, depth, frame, parts)
         draw_boxes(img, labels, fid, report)
         _text(img, f"{scene.scene_id} {fid}: {report.n_found}/{report.n_fronts} fronts found, "
-                   f"{len(report.false_parts)} false part(s)", (8, img.shape[0] - 10), (255, 255, 255))
+                   f"false parts: {len(report.false_parts)}", (8, img.shape[0] - 10), (255, 255, 255))
         path = args.out_dir / f"{args.prefix}{fid}.jpg"
         cv2.imwrite(str(path), cv2.cvtColor(img, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, 88])
         print(f"wrote {path}")
