@@ -89,24 +89,12 @@ def _fail(command: str, message: str, rc: int, details: bool) -> int:
     return rc
 
 
-_LOG_PATH: list[str] = []
-
-
-def log_path() -> str:
-    """This process's details log: ``$REACT3D_LOG_DIR`` (default: the temporary folder), created only
-    when something is written to it (a failure's traceback, Prefect's error records)."""
-    if not _LOG_PATH:
-        import tempfile
-        import time
-
-        folder = os.environ.get("REACT3D_LOG_DIR") or tempfile.gettempdir()
-        _LOG_PATH.append(os.path.join(folder, f"react3d-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.log"))
-    return _LOG_PATH[0]
-
-
 def _write_log(command: str, message: str) -> str | None:
-    """Append the details of a failure to :func:`log_path`; None if it cannot be written."""
+    """Append the details of a failure to the run's log (where Prefect's error records went too); None
+    if it cannot be written."""
     import traceback
+
+    from flows.commands._runconfig import log_path
 
     path = log_path()
     try:

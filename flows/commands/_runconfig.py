@@ -88,6 +88,23 @@ def _check_formats(formats: object) -> None:
         raise ConfigError(f"unknown export format(s) {', '.join(map(str, bad))}: choose from {', '.join(FORMATS)} or none")
 
 
+_LOG_PATH: list[str] = []
+
+
+def log_path() -> str:
+    """This process's details log: ``$REACT3D_LOG_DIR`` (default: the temporary folder), created only
+    when something is written to it (a failure's traceback, Prefect's error records). Kept here, not in
+    ``flows.cli``, which runs as ``__main__`` under ``python -m`` (a second module copy, a second path)."""
+    if not _LOG_PATH:
+        import os
+        import tempfile
+        import time
+
+        folder = os.environ.get("REACT3D_LOG_DIR") or tempfile.gettempdir()
+        _LOG_PATH.append(os.path.join(folder, f"react3d-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}.log"))
+    return _LOG_PATH[0]
+
+
 @contextlib.contextmanager
 def prefect_errors_to_log(path: str) -> Iterator[None]:
     """Prefect reports a failed task or flow as ERROR records with tracebacks on the console (84-113
@@ -146,8 +163,6 @@ def run_with_progress(scene: str, out: str, cfg: dict[str, Any], title: str) -> 
 
         bar.console.print(f"[dim]{title}[/dim]")
         cs.PROGRESS_HOOK = hook
-        from flows.cli import log_path
-
         try:
             with prefect_errors_to_log(log_path()):
                 return cs.convert_scene(scene, out, cfg)

@@ -36,9 +36,7 @@ def run(args: argparse.Namespace) -> int:
     cfg = pipeline_overrides(args)
     check_dataset_outputs(args.root, args.scenes, args.glob, args.out)  # before any scene runs
     console = Console()
-    from flows.cli import log_path
-
-    from ._runconfig import prefect_errors_to_log
+    from ._runconfig import log_path, prefect_errors_to_log
 
     # a failed scene is one row of the table below; Prefect's tracebacks for it go to the log file
     with console.status("converting scenes (per-scene progress in the Prefect UI when a server is configured)"), \

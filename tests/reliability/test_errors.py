@@ -52,7 +52,9 @@ def test_disk_full_is_one_line_and_leaves_nothing(small_fs: Path, scan: Path, cl
     assert len(lines) == 1 and "No space left on device" in lines[0] and "details: " in lines[0], r.stderr[-3000:]
     assert max(map(len, lines)) < 600
     log = Path(lines[0].split("details: ")[1].rstrip(")"))
-    assert log.is_file() and "Traceback" in log.read_text()  # Prefect's error records went here
+    text = log.read_text()
+    assert "ERROR prefect.task_runs" in text and "Traceback" in text  # Prefect's records and the traceback: one file
+    assert len([p for p in tmp_path.iterdir() if p.name.startswith("react3d-")]) == 1
     assert list(small_fs.iterdir()) == []  # no half-written output, no staging folder
 
 
