@@ -23,6 +23,7 @@ hit point, so they stick to surfaces and the same seed gives the same bytes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import cv2
 import numpy as np
@@ -180,6 +181,14 @@ def shift_image(img: np.ndarray, dx: float, dy: float) -> np.ndarray:
     return cv2.warpAffine(img, M, (img.shape[1], img.shape[0]), flags=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
 
 
+@lru_cache(maxsize=4)
+def _vignette(H: int, W: int) -> np.ndarray:
+    """Lens light falloff towards the corners (0.7 in the corners)."""
+    yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
+    r2n = ((xx - W / 2) ** 2 + (yy - H / 2) ** 2) / ((W / 2) ** 2 + (H / 2) ** 2)
+    return (1.0 - 0.3 * r2n).astype(np.float32)
+
+
 def render_photo(hit: dict[str, np.ndarray], faces: np.ndarray, colors: np.ndarray, face_mat: np.ndarray,
                  settings: PhotoSettings, frame_rng: np.random.Generator, noise_rng: np.random.Generator,
                  face_colors: np.ndarray | None = None) -> np.ndarray:
@@ -219,8 +228,10 @@ def render_photo(hit: dict[str, np.ndarray], faces: np.ndarray, colors: np.ndarr
         diffuse += 0.6 * np.clip(_dot(n, l), 0.0, None) * (power * 2.5 / (r2 + 0.8))
         h = l + vdir
         h /= np.sqrt(_dot(h, h)) + 1e-9
-        ndh = np.clip(_dot(n, h), 0.0, 1.0)
-        spec += power * 0.6 * (ks1 * ndh ** sh1 + ks2 * ndh ** sh2)  # a light's reflection: no 1/r^2
+        ndh = _dot(n, h)
+        lit = ndh > 0.75  # below, every lobe (shininess >= 8) is < 0.1 of its peak: skip the pow
+        nl = np.clip(ndh[lit], 0.0, 1.0)
+        spec[lit] += power * 0.6 * (ks1[lit] * nl ** sh1[lit] + ks2[lit] * nl ** sh2[lit])  # no 1/r^2: a reflection
     ndv = np.clip(_dot(n, vdir), 0.0, 1.0)
     fres = f0 + (1.0 - f0) * (1.0 - ndv) ** 5
     rz = d[2] + 2.0 * ndv * n[2]  # z of the reflected view ray
@@ -229,9 +240,7 @@ def render_photo(hit: dict[str, np.ndarray], faces: np.ndarray, colors: np.ndarr
     img = (albedo * (diffuse * occl)[..., None] + (spec * occl)[..., None]) * ok[..., None]
     gain = np.float32(1.5 * np.exp(frame_rng.normal(0.0, settings.exposure_sigma)))
     wb = np.exp(frame_rng.normal(0.0, 0.03, 3)).astype(np.float32)
-    yy, xx = np.mgrid[0:H, 0:W].astype(np.float32)
-    r2n = ((xx - W / 2) ** 2 + (yy - H / 2) ** 2) / ((W / 2) ** 2 + (H / 2) ** 2)
-    img = img.astype(np.float32) * (gain * wb)[None, None] * (1.0 - 0.3 * r2n)[..., None]
+    img = img.astype(np.float32) * (gain * wb)[None, None] * _vignette(H, W)[..., None]
     img = np.clip(img, 0.0, 1.0) * np.float32(255.0)
     img = _motion_blur(img, float(frame_rng.uniform(0.0, settings.blur_px)), float(frame_rng.uniform(0.0, np.pi)))
     img = shift_image(img, *settings.misregister)

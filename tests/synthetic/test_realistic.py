@@ -78,9 +78,10 @@ def test_transferred_gt_scores_perfect_and_lies_on_its_part(synthetic_scene, tmp
         assert (a["f1"], a["precision"], a["recall"], a["joint_acc"]) == (1.0, 1.0, 1.0, 1.0)
 
 
-def test_photo_and_tsdf_are_deterministic(synthetic_scene, tmp_path: Path) -> None:  # noqa: ANN001
-    a = synthetic_scene(mesh="tsdf", **SCENE)
-    b = generate_scene(tmp_path / "b", mesh="tsdf", **SCENE)
+@pytest.mark.parametrize("mesh", [pytest.param("laser", marks=pytest.mark.slow), "tsdf"])  # laser: ~21 s
+def test_photo_and_scan_meshes_are_deterministic(synthetic_scene, tmp_path: Path, mesh: str) -> None:  # noqa: ANN001
+    a = synthetic_scene(mesh=mesh, **SCENE)
+    b = generate_scene(tmp_path / "b", mesh=mesh, **SCENE)
     files = ["scans/mesh_aligned_0.05.ply", "iphone/depth.bin"] + [f"iphone/rgb/frame_{i:06d}.jpg" for i in range(5)]
     assert all(_sha(a / f) == _sha(b / f) for f in files)
     gt_a = read_articulate3d(a / "articulate3d")
