@@ -7,6 +7,15 @@ import argparse
 HELP = "Generate a synthetic scene with GT joints: procedural room, scene-synthesizer kitchen or any URDF."
 
 
+def _pixel_shift(text: str) -> tuple[float, float]:
+    """``DX,DY`` -> (dx, dy); a clear argparse error otherwise."""
+    try:
+        dx, dy = (float(x) for x in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected DX,DY in pixels (e.g. 2,1), got {text!r}") from None
+    return dx, dy
+
+
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="Output scene folder (replaced atomically).")
     p.add_argument("--seed", type=int, default=0)
@@ -22,7 +31,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                         "1 cm TSDF of the scene's own noisy depth + colour frames; GT is transferred to it.")
     p.add_argument("--realism", default="photo", choices=["plain", "photo"],
                    help="RGB renderer: photo (materials, highlights, light falloff, exposure, blur) or plain flat shading.")
-    p.add_argument("--misregister", default="0,0", metavar="DX,DY",
+    p.add_argument("--misregister", type=_pixel_shift, default=(0.0, 0.0), metavar="DX,DY",
                    help="Shift colour against depth by DX,DY pixels of the RGB image, like a Kinect (photo only).")
 
 
@@ -38,14 +47,17 @@ def run(args: argparse.Namespace) -> int:
     from react3d_core import __version__
     from react3d_core.atomic import OUTPUT_MARKER, check_output_dir
 
+    if args.realism == "plain" and args.misregister != (0.0, 0.0):
+        from react3d_core.errors import ConfigError
+
+        raise ConfigError("--misregister shifts the photo renderer's colour: it needs --realism photo")
     check_output_dir(args.out, (args.urdf,) if args.urdf else (), kind="synth")  # never replace the user's files
     console = Console()
     t0 = time.perf_counter()
     with console.status(f"rendering {args.frames} frames ({args.source}, seed {args.seed})"):
-        dx, dy = (float(x) for x in args.misregister.split(","))
         out = generate_scene(args.out, source=args.source, seed=args.seed, n_frames=args.frames,
                              urdf_path=args.urdf, kind=args.kind, edge=args.edge, mesh=args.mesh,
-                             realism=args.realism, misregister=(dx, dy))
+                             realism=args.realism, misregister=args.misregister)
     # deterministic (hidden files stay out of scan fingerprints): lets a later synth replace this folder
     (Path(out) / OUTPUT_MARKER).write_text(json.dumps({"react3d": __version__, "kind": "synth"}))
     meta = json.loads((Path(out) / "synth_meta.json").read_text())

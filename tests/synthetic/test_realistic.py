@@ -219,3 +219,17 @@ def test_bench_sets_pass_scan_options() -> None:
         assert [e.get("kind") for e in entries] == [e.get("kind") for e in heldout]
     tuning = load_spec("tuning_realistic", Path("/nonexistent"))
     assert {(e["seed"], e["synth"]["mesh"]) for e in tuning} == {(s, m) for s in range(10) for m in ("laser", "tsdf")}
+
+
+def test_synth_cli_scan_options(tmp_path: Path, capsys) -> None:  # noqa: ANN001
+    from flows.cli import main
+
+    assert main(["synth", "--out", str(tmp_path / "s"), "--realism", "plain", "--misregister", "2,1", "--frames", "2"]) == 2
+    assert "needs --realism photo" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["synth", "--out", str(tmp_path / "s"), "--misregister", "3"])
+    assert main(["synth", "--seed", "1", "--kind", "dresser", "--out", str(tmp_path / "t"), "--frames", "2",
+                 "--mesh", "tsdf", "--misregister", "2,1"]) == 0
+    meta = json.loads((tmp_path / "t" / "synth_meta.json").read_text())
+    assert meta["mesh"]["kind"] == "tsdf" and meta["realism"] == "photo" and meta["misregister_px"] == [2.0, 1.0]
+
