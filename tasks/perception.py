@@ -6,6 +6,7 @@ per-task overhead small; a GPU out-of-memory error splits the batch in half and 
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable, Sequence
 from typing import Any, TypeVar
@@ -24,12 +25,18 @@ from .store import put
 
 T = TypeVar("T")
 _BACKENDS: dict[tuple[str, str], Perception] = {}
+_BUILD_LOCK = threading.Lock()  # batches run in threads: build a backend once, not once per thread
 
 
 def get_perception(scene: SceneInput, cfg: PerceptionConfig) -> Perception:
     """The backend for this scene, built once per worker (models: once per worker for all scenes)."""
     cfg_json = cfg.model_dump_json()
     key = (cfg_json, "" if cfg.backend == "models" else str(scene.mesh_path))
+    with _BUILD_LOCK:
+        return _build(key, scene, cfg)
+
+
+def _build(key: tuple[str, str], scene: SceneInput, cfg: PerceptionConfig) -> Perception:
     if key not in _BACKENDS:
         if cfg.backend == "models":
             from tasks.models import make_model_perception

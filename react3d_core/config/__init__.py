@@ -17,7 +17,7 @@ from .articulation import ArticulationConfig, AssemblyConfig, CavityConfig, Dedu
 from .evaluation import EvaluationConfig
 from .export import ExportConfig
 from .frames import FrameSelectionConfig
-from .perception import OracleNoiseConfig, PerceptionConfig
+from .perception import HeuristicConfig, OracleNoiseConfig, PerceptionConfig
 from .segmentation import ClipConfig, FusionConfig, TopKConfig
 
 
@@ -80,6 +80,7 @@ __all__ = [
     "ExportConfig",
     "FrameSelectionConfig",
     "FusionConfig",
+    "HeuristicConfig",
     "LimitConfig",
     "OracleNoiseConfig",
     "PerceptionConfig",

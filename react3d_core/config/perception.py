@@ -26,6 +26,23 @@ class OracleNoiseConfig(StageConfig):
     seed: int = Field(0, description="Seed of the oracle's noise.")
 
 
+class HeuristicConfig(StageConfig):
+    """The weight-free heuristic's image path: fronts found in the colour frames (seams, handles)."""
+
+    image_fronts: bool = Field(True, description="Also find fronts in the colour frames (real scans have no seams in the mesh).")
+    ortho_resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
+    max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
+    calibrate_colour: bool = Field(True, description="Self-calibrate colour focal scale / principal point against the mesh (unregistered RGB-D).")
+    seam_contrast: float = Field(0.01, ge=0, description="A seam pixel is this much darker than both sides (fraction of the plane's mean).")
+    seam_span: float = Field(0.35, ge=0, le=1, description="A seam covers this fraction of the cell it splits.")
+    seam_prominence: float = Field(0.3, ge=0, le=1, description="... and this much more than the lines around it (vertical seams).")
+    seam_prominence_h: float = Field(0.5, ge=0, le=1, description="The same for horizontal seams (reflections of table/shelf edges are horizontal).")
+    handle_contrast: float = Field(0.12, ge=0, description="Colour distance of handle pixels from the local background.")
+    handle_len: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
+    handle_thick: tuple[float, float] = Field((0.014, 0.05), description="Short side of a handle (m).")
+    min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
+
+
 class PerceptionConfig(StageConfig):
     """Which backend runs each model call, and the paper's thresholds."""
 
@@ -46,6 +63,7 @@ class PerceptionConfig(StageConfig):
     batch_size: int = Field(8, ge=1, description="Frames per model call on GPU.")
     device: str = Field("auto", description="'auto', 'cpu', 'cuda', 'cuda:N'.")
     oracle: OracleNoiseConfig = Field(default_factory=OracleNoiseConfig)
+    heuristic: HeuristicConfig = Field(default_factory=HeuristicConfig)
 
     @field_validator("tag_filter_endpoint", "articulation_endpoint")
     @classmethod

@@ -1,10 +1,11 @@
 """Weight-free heuristic perception: openable fronts found geometrically on the scan mesh.
 
-Planar facets (faces joined where normals agree; seams between fronts separate them) that are
-vertical, rectangular, door/drawer-sized, seen by the cameras and carry a handle in front of them
-(or sit beside another such front) are openable fronts; the joint comes from shape and handle. All
-five perception calls read per-frame renders of these fronts. Named a heuristic: it needs the seams
-between fronts to exist in the mesh and misses handle-less lone fronts (docs/perception.md).
+Two sources of fronts: planar facets of the mesh (seams between fronts separate them) that are
+vertical, rectangular, door/drawer-sized and carry a handle (fronts.py), and — where the mesh has no
+seams, as in real scans — the colour frames: each large vertical plane is fused into an orthophoto
+from all views that see it and split at the seams and between the handles it shows
+(image_fronts.py). The joint comes from shape and handle. All five perception calls read per-frame
+renders of these fronts (docs/perception.md states the limits).
 """
 
 from __future__ import annotations
@@ -15,13 +16,15 @@ from ..interfaces import Perception
 from .backend import (HeuristicArticulation, HeuristicModel, HeuristicPointSegmenter, HeuristicSegmenter,
                       HeuristicTagger, KeepOpenable)
 from .fronts import FrontRules
+from .image_fronts import params_from_config
 
-STAGE_VERSION = "2"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45
+STAGE_VERSION = "3"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames
 
 
 def make_heuristic(scene: SceneInput, config: PerceptionConfig) -> Perception:
     """Build the heuristic backend for ``scene`` (facets and fronts are computed once here)."""
-    model = HeuristicModel(scene, FrontRules())
+    image = params_from_config(config.heuristic) if config.heuristic.image_fronts else None
+    model = HeuristicModel(scene, FrontRules(), image=image)
     return Perception(name="heuristic", tagger=HeuristicTagger(model), tag_filter=KeepOpenable(),
                       segmenter=HeuristicSegmenter(model), point_segmenter=HeuristicPointSegmenter(model),
                       articulation=HeuristicArticulation(model), version=STAGE_VERSION)

@@ -7,6 +7,7 @@ the segmenter, the point segmenter and the predictor share them.
 
 from __future__ import annotations
 
+import logging
 from collections import OrderedDict
 from collections.abc import Sequence
 
@@ -17,8 +18,12 @@ from ...data.frames import Frame, SceneInput
 from ...data.masks import ArticulationPrediction, Mask2D
 from ...data.mesh import TriMesh, load_mesh
 from ...raster import Rasterizer
+from ...scene_io.images import frame_rgb
 from .facets import planar_facets
 from .fronts import Front, FrontRules, find_fronts
+from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts
+
+log = logging.getLogger("react3d.perception")
 
 OPENABLE_TAGS = ("cabinet", "drawer", "door", "wardrobe", "dresser", "refrigerator", "oven", "dishwasher")
 MIN_MASK_PX = 150
@@ -27,7 +32,8 @@ MIN_MASK_PX = 150
 class HeuristicModel:
     """Facets, fronts and per-frame renders of one scene."""
 
-    def __init__(self, scene: SceneInput, rules: FrontRules = FrontRules(), scale: float = 0.5, n_probe: int = 24) -> None:
+    def __init__(self, scene: SceneInput, rules: FrontRules = FrontRules(), scale: float = 0.5, n_probe: int = 24,
+                 image: ImageFrontParams | None = ImageFrontParams()) -> None:
         self.scene = scene
         self.mesh: TriMesh = load_mesh(scene.mesh_path)
         self.raster = Rasterizer(self.mesh)
@@ -37,9 +43,31 @@ class HeuristicModel:
         visible, glimpsed, view_dirs = self._visible_facets(n_probe)
         cams = np.array([f.c2w[:3, 3] for f in scene.frames])
         self.fronts: list[Front] = find_fronts(self.mesh, self.facets, visible, cams.mean(0), rules, glimpsed, view_dirs)
+        self.image: ImageFronts | None = None
+        if image is not None and self._has_colour():
+            taken = np.zeros(self.mesh.n_faces, bool)
+            for fr in self.fronts:
+                taken[fr.faces] = True
+            self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, rules, image, taken)
+            self.fronts += self.image.fronts
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
         for i, fr in enumerate(self.fronts):
             self.face_front[fr.faces] = i
+
+    def _has_colour(self) -> bool:
+        """True when the first frame's colour image reads as a 3-channel image; otherwise one warning
+        line and the mesh-only path."""
+        if not self.scene.frames:
+            return False
+        try:
+            img = frame_rgb(self.scene.frames[0])
+        except Exception as exc:  # noqa: BLE001 - any unreadable colour means: no image evidence
+            log.warning("heuristic: colour frames unreadable (%s); finding fronts on the mesh only", exc)
+            return False
+        if img.ndim != 3 or img.shape[2] < 3 or float(img.std()) == 0.0:
+            log.warning("heuristic: frames carry no colour; finding fronts on the mesh only")
+            return False
+        return True
 
     def _visible_facets(self, n_probe: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Per facet: clearly visible (>= 40 px over >= 2 probe views), glimpsed (any pixel), and the

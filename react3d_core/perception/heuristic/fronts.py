@@ -55,6 +55,7 @@ class Front:
     kind: str = ""
     faces: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     frame_facets: list[int] = field(default_factory=list)  # the other facets of a frame-and-panel front
+    handle_points: np.ndarray | None = None  # handle seen in the images only (points on the front), else None
 
     @property
     def w(self) -> float:
@@ -114,6 +115,8 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
     cands = _drop_covered(cands)
     _absorb_frames(cands, facets, fv, fcent, faces_of, visible, rules)
     cands += _ring_fronts(cands, rings, facets, fv, fcent, faces_of, visible, rules)
+    if not cands:
+        return []  # e.g. every candidate was a carcass face covered by others
     # handles: small visible facets just in front of a candidate, inside its rectangle (nearest plane wins)
     in_front = np.zeros(facets.n, bool)
     for f in cands:
@@ -391,3 +394,17 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
     axis = _opening_sign(z.copy(), origin, probe, f.n_out)
     return "door", Articulation(joint_type="revolute", axis=axis, origin=origin, lower=0.0,
                                 upper=float(np.radians(100)), limit_source="heuristic")
+
+
+def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None:
+    """Bottom-hinged "drop" fronts side by side are cabinet doors with a bar handle on top, not ovens:
+    appliances come one at a time. Such a row (two or more touching drop fronts of the same height)
+    is re-typed as vertically hinged doors (hinge away from the neighbour of a pair, else left)."""
+    drops = [f for f in fronts if f.kind == "drop"]
+    for f in drops:
+        row = [g for g, side in _neighbours(f, drops, rules) if side in ("left", "right")]
+        if row:
+            f.kind = "row_door"
+    for f in fronts:
+        if f.kind == "row_door":
+            f.kind, f.articulation = _joint(f, None, _neighbours(f, fronts, rules), rules)

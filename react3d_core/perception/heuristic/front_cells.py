@@ -1,0 +1,255 @@
+"""Split a fused orthophoto of a vertical plane into front-sized cells, at seams and between handles.
+
+Seams are thin lines darker than both sides (the shadow in the gap between two fronts) or thin gaps
+in the mesh coverage; a seam must span most of the cell it splits (furniture is laid out in
+guillotine cuts: a run splits into columns, a column into drawers). Handles are compact elongated
+blobs whose colour differs from their surroundings (metal bars on paint). A cell still holding two
+handles side by side (or stacked) is split between them at the strongest seam evidence, so a missed
+seam costs nothing when both fronts have handles. Everything is in grid pixels of the orthophoto;
+thresholds are in metres or brightness ratios (the orthophoto is exposure-normalised to ~1).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+from scipy import ndimage
+
+from .orthophoto import Orthophoto
+
+
+@dataclass(frozen=True)
+class CellParams:
+    seam_contrast: float = 0.01      # a seam pixel is this much darker than both sides (fraction of mean)
+    seam_span: float = 0.35          # a seam covers this fraction of the cell's seen extent ...
+    seam_prominence: float = 0.3     # ... and this much more than the lines around it (median over 2 x min_front)
+    seam_prominence_h: float = 0.5   # the same for horizontal seams (reflections of table edges, shelves are horizontal)
+    min_front: float = 0.1           # m: no cell narrower than this
+    handle_contrast: float = 0.12    # colour distance of handle pixels from the local background
+    handle_len: tuple[float, float] = (0.1, 0.5)   # m: long side of a handle
+    handle_thick: tuple[float, float] = (0.014, 0.05)  # m: short side of a handle
+    handle_aspect: float = 2.5
+    background_win: float = 0.12     # m: window of the local background for handles
+    min_seen: float = 0.55           # a cell's mesh coverage fraction
+    max_clutter: float = 0.15        # fraction of a cell's pixels off its local background (posters, tiles, shelves)
+    max_depth: int = 6               # guillotine recursion depth
+
+
+@dataclass
+class Handle:
+    """A handle blob: its pixel box (c0, r0, c1, r1) and whether it is horizontal."""
+
+    box: tuple[int, int, int, int]
+    horizontal: bool
+    pixels: np.ndarray  # (N, 2) cols, rows
+
+    @property
+    def center(self) -> tuple[float, float]:
+        return 0.5 * (self.box[0] + self.box[2]), 0.5 * (self.box[1] + self.box[3])
+
+
+@dataclass
+class Cell:
+    """A rectangle of grid pixels [c0, c1) x [r0, r1), the handles inside it, and how many of its
+    sides are seams or handle splits (the region's outline counts as none)."""
+
+    c0: int
+    r0: int
+    c1: int
+    r1: int
+    handles: list[Handle] = field(default_factory=list)
+    cut_sides: int = 0
+
+
+def _valleys(g: np.ndarray, axis: int, contrast: float) -> np.ndarray:
+    """Pixels darker than both neighbours 1-3 px away along ``axis`` by ``contrast``."""
+    out = np.zeros(g.shape, bool)
+    for k in (1, 2, 3):
+        a = np.roll(g, k, axis)
+        b = np.roll(g, -k, axis)
+        out |= (np.minimum(a, b) - g) > contrast
+    return out
+
+
+def _gaps(valid: np.ndarray, axis: int) -> np.ndarray:
+    """Unseen pixels with seen pixels on both sides within 3 px along ``axis`` (thin mesh gaps)."""
+    out = np.zeros(valid.shape, bool)
+    for k in (1, 2, 3):
+        a = np.roll(valid, k, axis)
+        b = np.roll(valid, -k, axis)
+        out |= ~valid & a & b
+    return out
+
+
+def seam_maps(o: Orthophoto, p: CellParams) -> tuple[np.ndarray, np.ndarray]:
+    """Boolean maps of vertical-seam and horizontal-seam evidence."""
+    g = o.color.mean(-1)
+    valid = o.n_views > 0
+    # smooth along the seam direction only: a seam is a line, noise is not
+    gv = cv2.blur(g, (1, 9))
+    gh = cv2.blur(g, (9, 1))
+    vert = (_valleys(gv, 1, p.seam_contrast) & valid) | _gaps(valid, 1)
+    horiz = (_valleys(gh, 0, p.seam_contrast) & valid) | _gaps(valid, 0)
+    # a fused seam wobbles by a pixel (residual misregistration): tolerate it across the seam
+    vert = cv2.dilate(vert.astype(np.uint8), np.ones((1, 3), np.uint8)).astype(bool)
+    horiz = cv2.dilate(horiz.astype(np.uint8), np.ones((3, 1), np.uint8)).astype(bool)
+    return vert, horiz
+
+
+def off_background(o: Orthophoto, p: CellParams) -> np.ndarray:
+    """Colour distance of every pixel from its local background (median over ``background_win``)."""
+    valid = o.n_views > 0
+    if not valid.any():
+        return np.zeros(valid.shape, np.float32)
+    c = np.clip(o.color * 128, 0, 255).astype(np.uint8)
+    c[~valid] = np.median(c[valid], axis=0).astype(np.uint8)  # unseen pixels must not look like blobs
+    k = max(3, int(p.background_win / o.res) | 1)
+    bg = cv2.medianBlur(c, min(k, 255))
+    return np.linalg.norm(c.astype(np.float32) - bg.astype(np.float32), axis=-1) / 128.0
+
+
+def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.ndarray | None = None) -> list[Handle]:
+    """Compact elongated blobs whose colour differs from the local background (see module docstring)."""
+    valid = o.n_views > 0
+    if valid.sum() < 100:
+        return []
+    diff = off_background(o, p) if diff is None else diff
+    blob = ((diff > p.handle_contrast) & valid).astype(np.uint8)
+    # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
+    L = int(p.handle_len[1] / o.res) + 1
+    strips = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((1, L), np.uint8)) | \
+        cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
+    blob = blob & ~cv2.dilate(strips, np.ones((3, 3), np.uint8))
+    blob = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
+    g = max(3, int(0.02 / o.res) | 1)  # a bar broken by a highlight is one handle
+    blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=8)
+    out = []
+    for j in range(1, n):
+        x, y, w, h, area = stats[j]
+        long_, short = max(w, h) * o.res, min(w, h) * o.res
+        if not (p.handle_len[0] <= long_ <= p.handle_len[1] and p.handle_thick[0] <= short <= p.handle_thick[1]):
+            continue
+        if max(w, h) < p.handle_aspect * min(w, h) or area < 0.4 * w * h:
+            continue
+        # a handle sits on the front: mesh coverage around it on both sides across its length
+        pad = max(2, int(0.02 / o.res))
+        r0, r1, c0, c1 = max(0, y - pad), min(lab.shape[0], y + h + pad), max(0, x - pad), min(lab.shape[1], x + w + pad)
+        if coverage[r0:r1, c0:c1].mean() < 0.4:
+            continue
+        rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
+        out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1)))
+    return out
+
+
+def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], p: CellParams) -> list[Cell]:
+    """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs."""
+    rows, cols = np.nonzero(coverage)
+    if not len(rows):
+        return []
+    vert, horiz = seam_maps(o, p)
+    root = Cell(int(cols.min()), int(rows.min()), int(cols.max()) + 1, int(rows.max()) + 1)
+    min_px = max(2, int(p.min_front / o.res))
+    blocked_c = np.zeros(coverage.shape[1], bool)  # no cut runs through a handle
+    blocked_r = np.zeros(coverage.shape[0], bool)
+    for h in handles:
+        blocked_c[h.box[0]:h.box[2]] = True
+        blocked_r[h.box[1]:h.box[3]] = True
+    cells = _split(root, vert, horiz, coverage, p, min_px, 0, blocked_c, blocked_r, handles)
+    for c in cells:
+        c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
+    out: list[Cell] = []
+    for c in cells:
+        out += _split_handles(c, vert, horiz, coverage, min_px)
+    return out
+
+
+def _profile(ev: np.ndarray, cov: np.ndarray, axis: int, chunks: int = 1) -> np.ndarray:
+    """Fraction of covered pixels along ``axis`` that carry seam evidence, per line across it; with
+    ``chunks`` > 1 the smallest such fraction over that many equal pieces of the line (a seam runs the
+    whole length; a row of handles or a patch of noise does not)."""
+    if chunks > 1 and ev.shape[axis] >= 3 * chunks:
+        parts = zip(np.array_split(ev, chunks, axis), np.array_split(cov, chunks, axis))
+        return np.min([_profile(e, c, axis) for e, c in parts], axis=0)
+    n = cov.sum(axis)
+    return np.where(n > 0, (ev & cov).sum(axis) / np.maximum(n, 1), 0.0)
+
+
+def _best_cut(ev: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams,
+              blocked: np.ndarray) -> tuple[int, float]:
+    """Best split line (index in the cell, prominence) keeping ``min_px`` on each side; lines covering
+    less than ``seam_span`` of the cell score 0."""
+    prof = _profile(ev, cov, axis)
+    if len(prof) <= 2 * min_px:
+        return -1, 0.0
+    prom = prof - ndimage.median_filter(prof, size=2 * min_px + 1, mode="nearest")
+    prom = np.where((prof >= p.seam_span) & (_profile(ev, cov, axis, 3) >= 0.5 * p.seam_span) & ~blocked, prom, 0.0)
+    inner = prom[min_px:len(prof) - min_px]
+    i = int(np.argmax(inner))
+    return i + min_px, float(inner[i])
+
+
+def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: CellParams, min_px: int,
+           depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle]) -> list[Cell]:
+    """Recursive guillotine split at the most prominent seam. Inside a cell holding handles, a
+    horizontal cut must leave a handle on both sides (glossy fronts reflect horizontal table and
+    shelf edges at a constant height; a drawer above a door carries its own handle)."""
+    if depth >= p.max_depth:
+        return [c]
+    sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
+    cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
+    ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])  # profile over rows
+    sc_v = sc_v if sc_v >= p.seam_prominence else 0.0
+    sc_h = sc_h if sc_h >= p.seam_prominence_h else 0.0
+    mine = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
+    if sc_h and mine:
+        cut = c.r0 + ch_
+        if not (any(h.center[1] < cut for h in mine) and any(h.center[1] > cut for h in mine)):
+            sc_h = 0.0
+    if max(sc_v, sc_h) == 0.0:
+        return [c]
+    if sc_v >= sc_h:
+        a = Cell(c.c0, c.r0, c.c0 + cv_, c.r1, cut_sides=c.cut_sides + 1)
+        b = Cell(c.c0 + cv_ + 1, c.r0, c.c1, c.r1, cut_sides=c.cut_sides + 1)
+    else:
+        a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=c.cut_sides + 1)
+        b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=c.cut_sides + 1)
+    return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine)
+            + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine))
+
+
+def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int) -> list[Cell]:
+    """Split a cell between consecutive handles (side by side: at the best column between them;
+    stacked: at the best row), recursively, so every cell ends with at most one handle per row/column."""
+    if len(c.handles) < 2:
+        return [c]
+    hs = sorted(c.handles, key=lambda h: h.center[0])
+    xs = [h.center[0] for h in hs]
+    ys = sorted(h.center[1] for h in hs)
+    span_x, span_y = xs[-1] - xs[0], ys[-1] - ys[0]
+    if max(span_x, span_y) < min_px:
+        return [c]
+    if span_x >= span_y:
+        gaps = np.diff(xs)
+        k = int(np.argmax(gaps))
+        lo, hi = int(hs[k].box[2]), int(hs[k + 1].box[0])
+        if hi - lo < 2:
+            lo, hi = int(xs[k]), int(xs[k + 1])
+        prof = _profile(vert[c.r0:c.r1, lo:hi], cov[c.r0:c.r1, lo:hi], 0) if hi > lo else np.zeros(0)
+        cut = lo + int(np.argmax(prof)) if len(prof) and prof.max() > 0.2 else (lo + hi) // 2
+        a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1)
+        b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1)
+    else:
+        hs = sorted(c.handles, key=lambda h: h.center[1])
+        ys = [h.center[1] for h in hs]
+        k = int(np.argmax(np.diff(ys)))
+        lo, hi = int(hs[k].box[3]), int(hs[k + 1].box[1])
+        if hi - lo < 2:
+            lo, hi = int(ys[k]), int(ys[k + 1])
+        prof = _profile(horiz[lo:hi, c.c0:c.c1], cov[lo:hi, c.c0:c.c1], 1) if hi > lo else np.zeros(0)
+        cut = lo + int(np.argmax(prof)) if len(prof) and prof.max() > 0.2 else (lo + hi) // 2
+        a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1)
+        b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1)
+    return _split_handles(a, vert, horiz, cov, min_px) + _split_handles(b, vert, horiz, cov, min_px)

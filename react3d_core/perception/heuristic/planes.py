@@ -1,0 +1,154 @@
+"""Large vertical planes of a scan mesh, found by normal direction and offset rather than by facets.
+
+Real scan meshes (TSDF, laser) have no seams between fronts and round their corners, so facet growing
+joins a whole L-shaped cabinet run into one region. Here faces vote for a horizontal normal direction
+(area-weighted histogram) and, per dominant direction, for a plane offset; faces near a peak form a
+plane, split into spatially connected pieces on a coarse grid in the plane. Fully vectorized.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from ...data.mesh import TriMesh
+
+
+@dataclass
+class Plane:
+    """One vertical planar region: outward normal ``n`` (horizontal), in-plane right ``u``, offset
+    ``d`` (n·x = d), its faces and its extent in (u, z)."""
+
+    n: np.ndarray
+    u: np.ndarray
+    d: float
+    faces: np.ndarray
+    extent_u: tuple[float, float]
+    extent_v: tuple[float, float]
+    area: float
+
+    def to_world(self, uu: np.ndarray, vv: np.ndarray, depth: float = 0.0) -> np.ndarray:
+        """Points at in-plane coordinates (uu, vv=z), ``depth`` in front of the plane."""
+        uu, vv = np.broadcast_arrays(np.asarray(uu, float), np.asarray(vv, float))
+        return (self.n * (self.d + depth) + uu[..., None] * self.u
+                + vv[..., None] * np.array([0.0, 0.0, 1.0]))
+
+
+def _peaks(hist: np.ndarray, min_weight: float, min_sep: int, circular: bool) -> list[int]:
+    """Indices of local maxima of a (smoothed) histogram above ``min_weight``, strongest first,
+    at least ``min_sep`` bins apart."""
+    order = np.argsort(-hist)
+    taken: list[int] = []
+    n = len(hist)
+    half = max(1, min_sep // 2)
+    local_max = ndimage.maximum_filter1d(hist, 2 * half + 1, mode="wrap" if circular else "constant") <= hist
+    for i in order:
+        if hist[i] < min_weight:
+            break
+        if not local_max[i]:
+            continue
+        if circular:
+            ok = all(min(abs(i - j), n - abs(i - j)) >= min_sep for j in taken)
+        else:
+            ok = all(abs(i - j) >= min_sep for j in taken)
+        if ok:
+            taken.append(int(i))
+    return taken
+
+
+def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 0.3, angle_tol_deg: float = 12.0,
+                    offset_tol: float = 0.025, min_area: float = 0.08, cell: float = 0.04,
+                    view_dirs: np.ndarray | None = None) -> list[Plane]:
+    """Vertical planes of at least ``min_area`` m².
+
+    A face belongs to a plane when its normal is within ``angle_tol_deg`` of the plane's horizontal
+    normal (either sign) and its centroid within ``offset_tol`` of the plane. Normals point towards
+    the cameras (``view_dirs``: per-face summed directions to cameras that saw it, else
+    ``cam_center``). Pieces of one plane separated by more than ``cell`` become separate planes."""
+    if mesh.n_faces == 0:
+        return []
+    t = mesh.vertices[mesh.faces]
+    nrm = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    area = 0.5 * np.linalg.norm(nrm, axis=1)
+    nrm = nrm / np.maximum(2 * area, 1e-15)[:, None]
+    cen = t.mean(1)
+    vert = (np.abs(nrm[:, 2]) <= max_tilt) & (area > 0)
+    if not vert.any():
+        return []
+    # orientation-free direction histogram over [0, 180) degrees, 1-degree bins
+    theta = np.degrees(np.arctan2(nrm[:, 1], nrm[:, 0])) % 180.0
+    bins = np.floor(theta).astype(int) % 180
+    hist = np.bincount(bins[vert], weights=area[vert], minlength=180)
+    hist = ndimage.uniform_filter1d(hist, 5, mode="wrap")
+    planes: list[Plane] = []
+    peaks = np.array(_peaks(hist, min_area / 5, 6, circular=True), float)
+    if not len(peaks):
+        return []
+    # each face goes to its nearest direction peak (a cabinet turned by 9 degrees is its own plane)
+    dist = np.abs((theta[:, None] - peaks[None] + 90.0) % 180.0 - 90.0)
+    nearest = dist.argmin(1)
+    for j, peak in enumerate(peaks):
+        dth = (theta - peak + 90.0) % 180.0 - 90.0
+        near = vert & (nearest == j) & (np.abs(dth) <= angle_tol_deg)
+        if area[near].sum() < min_area:
+            continue
+        ang = np.radians(peak + np.average(dth[near], weights=area[near]))
+        nd = np.array([np.cos(ang), np.sin(ang), 0.0])
+        off = cen[near] @ nd
+        lo = off.min()
+        nb = int((off.max() - lo) / 0.005) + 1
+        oh = np.bincount(((off - lo) / 0.005).astype(int), weights=area[near], minlength=nb)
+        oh = ndimage.uniform_filter1d(oh, max(1, int(offset_tol / 0.005)), mode="constant")
+        idx_near = np.flatnonzero(near)
+        for pk in _peaks(oh, min_area / 10, int(2 * offset_tol / 0.005), circular=False):
+            d0 = lo + (pk + 0.5) * 0.005
+            sel = idx_near[np.abs(off - d0) <= offset_tol]
+            if area[sel].sum() < min_area:
+                continue
+            planes += _pieces(sel, cen, area, nd, float(np.average(cen[sel] @ nd, weights=area[sel])), cell, min_area)
+    # orient each plane's normal towards the cameras that see it
+    out = []
+    for p in planes:
+        if view_dirs is not None:
+            toward = view_dirs[p.faces].sum(0)
+        else:
+            toward = cam_center - p.to_world(np.mean(p.extent_u), np.mean(p.extent_v))
+        if np.dot(p.n, toward) < 0:
+            p = _flip(p)
+        out.append(p)
+    out.sort(key=lambda p: -p.area)
+    return out
+
+
+def _basis(n: np.ndarray) -> np.ndarray:
+    u = np.cross([0.0, 0.0, 1.0], n)  # right-hand side when looking at the plane from its front
+    return u / np.linalg.norm(u)
+
+
+def _flip(p: Plane) -> Plane:
+    u = _basis(-p.n)
+    return Plane(-p.n, u, -p.d, p.faces, (-p.extent_u[1], -p.extent_u[0]), p.extent_v, p.area)
+
+
+def _pieces(sel: np.ndarray, cen: np.ndarray, area: np.ndarray, n: np.ndarray, d: float, cell: float,
+            min_area: float) -> list[Plane]:
+    """Split the faces ``sel`` of one plane into pieces connected on a ``cell`` grid."""
+    u = _basis(n)
+    pu, pv = cen[sel] @ u, cen[sel, 2]
+    iu = np.floor((pu - pu.min()) / cell).astype(int)
+    iv = np.floor((pv - pv.min()) / cell).astype(int)
+    grid = np.zeros((iv.max() + 1, iu.max() + 1), bool)
+    grid[iv, iu] = True
+    lab, k = ndimage.label(ndimage.binary_closing(grid, np.ones((3, 3)), border_value=0) | grid, np.ones((3, 3)))
+    fl = lab[iv, iu]
+    out = []
+    for j in range(1, k + 1):
+        m = fl == j
+        a = float(area[sel[m]].sum())
+        if a < min_area:
+            continue
+        out.append(Plane(n.copy(), u, d, sel[m], (float(pu[m].min()), float(pu[m].max())),
+                         (float(pv[m].min()), float(pv[m].max())), a))
+    return out
