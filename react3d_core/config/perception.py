@@ -33,13 +33,14 @@ class HeuristicConfig(StageConfig):
     ortho_resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
     max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
     calibrate_colour: bool = Field(True, description="Self-calibrate colour focal scale / principal point against the mesh (unregistered RGB-D).")
+    per_view_colour: bool = Field(False, description="Refine the colour calibration per view against the consensus of all views.")
     seam_contrast: float = Field(0.01, ge=0, description="A seam pixel is this much darker than both sides (fraction of the plane's mean).")
     seam_span: float = Field(0.35, ge=0, le=1, description="A seam covers this fraction of the cell it splits.")
     seam_prominence: float = Field(0.3, ge=0, le=1, description="... and this much more than the lines around it (vertical seams).")
     seam_prominence_h: float = Field(0.5, ge=0, le=1, description="The same for horizontal seams (reflections of table/shelf edges are horizontal).")
     handle_contrast: float = Field(0.12, ge=0, description="Colour distance of handle pixels from the local background.")
     handle_len: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
-    handle_thick: tuple[float, float] = Field((0.014, 0.05), description="Short side of a handle (m).")
+    handle_thick: tuple[float, float] = Field((0.014, 0.07), description="Short side of a handle (m).")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
 
 

@@ -48,8 +48,9 @@ class HeuristicModel:
             taken = np.zeros(self.mesh.n_faces, bool)
             for fr in self.fronts:
                 taken[fr.faces] = True
-            self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, rules, image, taken)
-            self.fronts += self.image.fronts
+            self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, rules, image, taken,
+                                           self.fronts)
+            self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
         for i, fr in enumerate(self.fronts):
             self.face_front[fr.faces] = i

@@ -29,11 +29,12 @@ class CellParams:
     min_front: float = 0.1           # m: no cell narrower than this
     handle_contrast: float = 0.12    # colour distance of handle pixels from the local background
     handle_len: tuple[float, float] = (0.1, 0.5)   # m: long side of a handle
-    handle_thick: tuple[float, float] = (0.014, 0.05)  # m: short side of a handle
-    handle_aspect: float = 2.5
+    handle_thick: tuple[float, float] = (0.014, 0.07)  # m: short side of a handle (protruding bars smear by parallax)
+    handle_aspect: float = 2.2
     background_win: float = 0.12     # m: window of the local background for handles
     min_seen: float = 0.55           # a cell's mesh coverage fraction
-    max_clutter: float = 0.15        # fraction of a cell's pixels off its local background (posters, tiles, shelves)
+    max_clutter: float = 0.18        # fraction of a cell's pixels off its local background (posters, tiles, shelves)
+    texture_factor: float = 3.0      # handle/seam thresholds rise to this many times the plane's median response
     max_depth: int = 6               # guillotine recursion depth
 
 
@@ -73,6 +74,15 @@ def _valleys(g: np.ndarray, axis: int, contrast: float) -> np.ndarray:
     return out
 
 
+def _contrast(g: np.ndarray, axis: int, valid: np.ndarray, p: CellParams) -> float:
+    """Valley contrast for seams: ``seam_contrast``, raised on textured planes (wood grain makes thin
+    dark lines everywhere) to ``texture_factor`` x the plane's median valley depth."""
+    if not valid.any():
+        return p.seam_contrast
+    depth = np.maximum(np.minimum(np.roll(g, 2, axis), np.roll(g, -2, axis)) - g, 0.0)
+    return max(p.seam_contrast, 0.5 * p.texture_factor * float(np.median(depth[valid])))
+
+
 def _gaps(valid: np.ndarray, axis: int) -> np.ndarray:
     """Unseen pixels with seen pixels on both sides within 3 px along ``axis`` (thin mesh gaps)."""
     out = np.zeros(valid.shape, bool)
@@ -90,8 +100,8 @@ def seam_maps(o: Orthophoto, p: CellParams) -> tuple[np.ndarray, np.ndarray]:
     # smooth along the seam direction only: a seam is a line, noise is not
     gv = cv2.blur(g, (1, 9))
     gh = cv2.blur(g, (9, 1))
-    vert = (_valleys(gv, 1, p.seam_contrast) & valid) | _gaps(valid, 1)
-    horiz = (_valleys(gh, 0, p.seam_contrast) & valid) | _gaps(valid, 0)
+    vert = (_valleys(gv, 1, _contrast(gv, 1, valid, p)) & valid) | _gaps(valid, 1)
+    horiz = (_valleys(gh, 0, _contrast(gh, 0, valid, p)) & valid) | _gaps(valid, 0)
     # a fused seam wobbles by a pixel (residual misregistration): tolerate it across the seam
     vert = cv2.dilate(vert.astype(np.uint8), np.ones((1, 3), np.uint8)).astype(bool)
     horiz = cv2.dilate(horiz.astype(np.uint8), np.ones((3, 1), np.uint8)).astype(bool)
@@ -110,19 +120,24 @@ def off_background(o: Orthophoto, p: CellParams) -> np.ndarray:
     return np.linalg.norm(c.astype(np.float32) - bg.astype(np.float32), axis=-1) / 128.0
 
 
-def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.ndarray | None = None) -> list[Handle]:
+def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.ndarray | None = None,
+                 protrusion: np.ndarray | None = None) -> list[Handle]:
     """Compact elongated blobs whose colour differs from the local background (see module docstring)."""
     valid = o.n_views > 0
     if valid.sum() < 100:
         return []
     diff = off_background(o, p) if diff is None else diff
-    blob = ((diff > p.handle_contrast) & valid).astype(np.uint8)
+    # textured fronts (wood grain) deviate everywhere: a handle stands out of the plane's own texture
+    thr = max(p.handle_contrast, p.texture_factor * float(np.median(diff[valid])))
+    blob = ((diff > thr) & valid).astype(np.uint8)
+    if protrusion is not None:  # a handle that is in the mesh: its footprint in front of the plane
+        blob |= protrusion.astype(np.uint8)
     # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
     L = int(p.handle_len[1] / o.res) + 1
     strips = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((1, L), np.uint8)) | \
         cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
     blob = blob & ~cv2.dilate(strips, np.ones((3, 3), np.uint8))
-    blob = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((2, 2), np.uint8))
+    blob = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))  # cuts 1-2 px grain bridges
     g = max(3, int(0.02 / o.res) | 1)  # a bar broken by a highlight is one handle
     blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
     n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=8)

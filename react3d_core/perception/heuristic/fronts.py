@@ -397,14 +397,26 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
 
 
 def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None:
-    """Bottom-hinged "drop" fronts side by side are cabinet doors with a bar handle on top, not ovens:
-    appliances come one at a time. Such a row (two or more touching drop fronts of the same height)
-    is re-typed as vertically hinged doors (hinge away from the neighbour of a pair, else left)."""
-    drops = [f for f in fronts if f.kind == "drop"]
-    for f in drops:
-        row = [g for g, side in _neighbours(f, drops, rules) if side in ("left", "right")]
-        if row:
-            f.kind = "row_door"
+    """Bottom- or top-hinged guesses ("drop", "flap") for fronts standing in a row with a same-height
+    neighbour whose horizontal bar handle is at the same height are cabinet doors with bar handles, not
+    ovens or flaps: appliances come one at a time and a flap has no door beside it with the same handle.
+    Such fronts are re-typed as vertically hinged doors (hinge away from the neighbour of a pair, else
+    left). Handles are those in ``handle_points`` (images) or the handle facets (mesh)."""
+    def bar_height(f: Front) -> float | None:
+        hp = f.handle_points
+        if hp is None or not len(hp):
+            return None
+        return float(hp[:, 2].mean()) if np.ptp(hp @ f.u) >= np.ptp(hp[:, 2]) else None
+
+    retype = []
     for f in fronts:
-        if f.kind == "row_door":
-            f.kind, f.articulation = _joint(f, None, _neighbours(f, fronts, rules), rules)
+        if f.kind not in ("drop", "flap") or bar_height(f) is None:
+            continue
+        for g, side in _neighbours(f, fronts, rules):
+            hg = bar_height(g)
+            if side in ("left", "right") and hg is not None and abs(hg - bar_height(f)) < 0.1:
+                retype.append(f)
+                break
+    for f in retype:
+        f.kind, f.articulation = _joint(f, None, _neighbours(f, fronts, rules), rules)
+        f.kind = "door"

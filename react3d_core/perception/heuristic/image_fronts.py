@@ -39,7 +39,8 @@ class ImageFrontParams:
 def params_from_config(cfg: "HeuristicConfig") -> ImageFrontParams:  # noqa: F821 - pydantic model
     """The image path's parameters from the pipeline config (every threshold lives there)."""
     return ImageFrontParams(
-        ortho=OrthoParams(resolution=cfg.ortho_resolution, max_views=cfg.max_views, calibrate=cfg.calibrate_colour),
+        ortho=OrthoParams(resolution=cfg.ortho_resolution, max_views=cfg.max_views, calibrate=cfg.calibrate_colour,
+                          per_view=cfg.per_view_colour),
         cells=CellParams(seam_contrast=cfg.seam_contrast, seam_span=cfg.seam_span, seam_prominence=cfg.seam_prominence,
                          seam_prominence_h=cfg.seam_prominence_h, handle_contrast=cfg.handle_contrast,
                          handle_len=tuple(cfg.handle_len), handle_thick=tuple(cfg.handle_thick)),
@@ -52,6 +53,7 @@ class ImageFronts:
     calibration (kept for reports and debugging)."""
 
     fronts: list[Front]
+    vetoed: list[int]  # indices of mesh fronts the photos show to be clutter (tiles, posters)
     planes: list[Plane]
     orthophotos: list[Orthophoto]
     calibration: ColourCalibration
@@ -76,22 +78,46 @@ def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = 0.03) -> np.nda
     return keep[lab]
 
 
+def cov_outline(cov: np.ndarray, px: int = 15) -> np.ndarray:
+    """The plane's outline with holes up to ``px`` closed (a handle's scanning shadow is a hole)."""
+    return cv2.morphologyEx(cov.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((px, px), np.uint8)).astype(bool)
+
+
+def protrusion_map(o: Orthophoto, mesh: TriMesh, centroids: np.ndarray, normals: np.ndarray,
+                   depth: tuple[float, float] = (0.012, 0.09)) -> np.ndarray:
+    """Grid pixels under outward-facing faces standing ``depth`` in front of the plane (handles in
+    the mesh), splatted by centroid and closed over 2 px."""
+    h, w = o.n_views.shape
+    p = o.plane
+    dn = centroids @ p.n - p.d
+    sel = (dn > depth[0]) & (dn < depth[1]) & (normals @ p.n > 0.5)
+    c = np.floor((centroids[sel] @ p.u - o.u0) / o.res).astype(int)
+    r = np.floor((o.v_top - centroids[sel, 2]) / o.res).astype(int)
+    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+    out = np.zeros((h, w), np.uint8)
+    out[r[ok], c[ok]] = 1
+    return cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((5, 5), np.uint8)).astype(bool)
+
+
 def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, read_rgb: Callable[[Frame], np.ndarray],
                       rules: FrontRules = FrontRules(), params: ImageFrontParams = ImageFrontParams(),
-                      taken_faces: np.ndarray | None = None) -> ImageFronts:
+                      taken_faces: np.ndarray | None = None, mesh_fronts: Sequence[Front] = ()) -> ImageFronts:
     """Fronts from the colour frames (see module docstring). ``taken_faces`` (bool per face) are
     faces of fronts already found on the mesh: cells overlapping them are left to the mesh rules."""
     cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, 3))
     planes = vertical_planes(mesh, cams.mean(0), max_tilt=rules.max_tilt, angle_tol_deg=params.plane_angle_tol_deg,
                              offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h))
     orthos, calib = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
-    centroids = mesh.vertices[mesh.faces].mean(1)
+    tri = mesh.vertices[mesh.faces]
+    centroids = tri.mean(1)
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-15)
     fronts: list[Front] = []
     for o in orthos:
         cov = coverage_map(o, mesh)
         o.n_views[~cov] = 0  # where the plane's own faces are not (floor, worktop edge seen at the same depth)
         diff = off_background(o, params.cells)
-        handles = find_handles(o, cov, params.cells, diff)
+        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, mesh, centroids, normals) & cov_outline(cov))
         clutter = (diff > params.cells.handle_contrast) & (o.n_views > 0)
         for h in handles:  # a handle is not clutter
             clutter[h.pixels[:, 1], h.pixels[:, 0]] = False
@@ -99,11 +125,36 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
             f = _cell_front(o, cell, cov, clutter, centroids, rules, params, taken_faces)
             if f is not None:
                 fronts.append(f)
+    # a handle-less cell is a front only beside a front with a handle (tiles and splash-backs have none)
+    fronts = [f for f in fronts if f.handle_points is not None
+              or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
     for f in fronts:
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else None
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
-    return ImageFronts(fronts, planes, orthos, calib)
+    vetoed = [k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, params)]
+    return ImageFronts(fronts, vetoed, planes, orthos, calib)
+
+
+def _cluttered(f: Front, orthos: Sequence[Orthophoto], params: ImageFrontParams) -> bool:
+    """A mesh front whose picture is cluttered (a tiled wall with a socket "handle") is not a front:
+    its rectangle in the orthophoto of its plane has more than ``max_clutter`` off-background pixels."""
+    for o in orthos:
+        p = o.plane
+        if np.dot(p.n, f.n_out) < 0.97 or abs(float(f.center @ p.n) - p.d) > 0.03:
+            continue
+        h, w = o.n_views.shape
+        c0, c1 = int((f.extent_u[0] - o.u0) / o.res), int(np.ceil((f.extent_u[1] - o.u0) / o.res))
+        r0, r1 = int((o.v_top - f.extent_v[1]) / o.res), int(np.ceil((o.v_top - f.extent_v[0]) / o.res))
+        c0, c1, r0, r1 = max(c0, 0), min(c1, w), max(r0, 0), min(r1, h)
+        if c1 - c0 < 5 or r1 - r0 < 5:
+            continue
+        seen = o.n_views[r0:r1, c0:c1] > 0
+        if seen.sum() < 0.3 * seen.size:
+            continue
+        diff = off_background(o, params.cells)[r0:r1, c0:c1]
+        return bool((diff[seen] > params.cells.handle_contrast).mean() > params.cells.max_clutter)
+    return False
 
 
 def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, centroids: np.ndarray, rules: FrontRules,

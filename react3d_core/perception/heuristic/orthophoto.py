@@ -42,7 +42,7 @@ class OrthoParams:
     scale_range: tuple[float, float] = (0.84, 1.12)
     shift_range_px: float = 16.0  # at 640 px image width
     min_gain: float = 0.2         # a calibration must cut the disagreement by this fraction to be used
-    per_view: bool = True         # then refine scale/shift per view against the consensus of all views
+    per_view: bool = False        # then refine scale/shift per view against the consensus (RedKitchen: 6 -> 3 of 9 fronts, off)
     view_shift_px: float = 12.0   # per-view search range around the scene's calibration (640 px width)
     view_scale: float = 0.04
 
@@ -57,6 +57,7 @@ class Orthophoto:
     u0: float
     v_top: float
     res: float
+    spread: np.ndarray | None = None  # per-pixel median |view - fused| brightness: high where things protrude (parallax)
 
     @property
     def valid(self) -> np.ndarray:
@@ -144,9 +145,11 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             st = np.stack(stack)
             n = np.isfinite(st[..., 0]).sum(0)
             color = _nanmedian(st)
+            spread = _nanmedian(np.abs(st.mean(-1) - color.mean(-1)[None]))
         else:
             n, color = np.zeros(pts.shape[:2], np.int32), np.zeros(pts.shape[:2] + (3,), np.float32)
-        out.append(Orthophoto(p, color, n.astype(np.int32), u0, v_top, res))
+            spread = np.zeros(pts.shape[:2], np.float32)
+        out.append(Orthophoto(p, color, n.astype(np.int32), u0, v_top, res, spread))
     return out, calib
 
 

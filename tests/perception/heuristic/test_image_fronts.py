@@ -1,0 +1,174 @@
+"""Fronts found in the colour frames: plane voting, robust fusion, seam/handle cells, and a seamless
+mesh whose fronts only the photos show (the real-scan situation, built by hand)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from react3d_core.camera import look_at
+from react3d_core.data.frames import Frame, ImageRef, Intrinsics
+from react3d_core.data.mesh import TriMesh
+from react3d_core.perception.heuristic.facets import planar_facets
+from react3d_core.perception.heuristic.front_cells import CellParams, find_handles, split_cells
+from react3d_core.perception.heuristic.fronts import find_fronts
+from react3d_core.perception.heuristic.image_fronts import find_image_fronts
+from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, OrthoParams, _nanmedian
+from react3d_core.perception.heuristic.planes import Plane, vertical_planes
+from react3d_core.raster import Rasterizer
+from react3d_core.synthetic.render import RayCaster
+
+
+def _grid_mesh(x0: float, x1: float, z0: float, z1: float, y: float, step: float, colour) -> TriMesh:  # noqa: ANN001
+    """A flat vertical sheet at ``y`` (no seams), facing -y, coloured per vertex by ``colour(x, z)``."""
+    xs = np.arange(x0, x1 + 1e-9, step)
+    zs = np.arange(z0, z1 + 1e-9, step)
+    X, Z = np.meshgrid(xs, zs)
+    v = np.stack([X.ravel(), np.full(X.size, y), Z.ravel()], 1)
+    nx = len(xs)
+    i = np.arange(len(zs) - 1)[:, None] * nx + np.arange(nx - 1)[None]
+    i = i.ravel()
+    f = np.concatenate([np.stack([i, i + 1, i + nx + 1], 1), np.stack([i, i + nx + 1, i + nx], 1)])
+    return TriMesh(v, f, colour(v[:, 0], v[:, 2]))
+
+
+def _merge(*meshes: TriMesh) -> TriMesh:
+    off = np.cumsum([0] + [m.n_vertices for m in meshes[:-1]])
+    return TriMesh(np.concatenate([m.vertices for m in meshes]), np.concatenate([m.faces + o for m, o in zip(meshes, off)]),
+                   np.concatenate([m.colors for m in meshes]))
+
+
+def test_nanmedian_hand_computed() -> None:
+    st = np.array([[1.0, np.nan], [3.0, 2.0], [2.0, np.nan], [np.nan, np.nan]], np.float32)[:, :, None]  # (V=4, 2, 1)
+    st = st.reshape(4, 1, 2)
+    out = _nanmedian(st)
+    assert out.shape == (1, 2)
+    assert out[0, 0] == pytest.approx(2.0)      # median of 1, 3, 2
+    assert out[0, 1] == pytest.approx(2.0)      # one view only
+    assert _nanmedian(np.full((3, 1, 1), np.nan, np.float32))[0, 0] == 0.0  # no view: 0
+
+
+def test_vertical_planes_split_l_shape_and_turned_cabinet() -> None:
+    """An L of two walls meeting at a rounded corner is two planes; a unit turned by 9 degrees is its own."""
+    grey = lambda x, z: np.full((len(x), 3), 150, np.uint8)  # noqa: E731
+    back = _grid_mesh(0.0, 2.0, 0.0, 0.9, 2.0, 0.02, grey)                       # n = -y, y = 2
+    side = _grid_mesh(0.0, 1.5, 0.0, 0.9, 0.0, 0.02, grey)
+    side = TriMesh(side.vertices[:, [1, 0, 2]], side.faces[:, ::-1], side.colors)   # x = 0 plane, facing +x
+    a = np.radians(9.0)
+    unit = _grid_mesh(0.0, 0.8, 0.5, 1.0, 0.0, 0.02, grey)
+    R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+    unit = TriMesh(unit.vertices @ R.T + [1.0, 3.5, 0.0], unit.faces, unit.colors)
+    planes = vertical_planes(_merge(back, side, unit), np.array([1.0, 1.0, 1.2]), min_area=0.2)
+    normals = sorted((tuple(np.round(p.n, 2)), round(p.area, 1)) for p in planes)
+    assert len(planes) == 3, normals
+    by_area = sorted(planes, key=lambda p: -p.area)
+    assert abs(by_area[0].n @ [0, -1, 0]) > 0.99 and by_area[0].area == pytest.approx(1.8, abs=0.05)
+    assert abs(by_area[1].n @ [1, 0, 0]) > 0.99 and by_area[1].area == pytest.approx(1.35, abs=0.05)
+    assert np.degrees(np.arccos(abs(by_area[2].n @ [0, 1, 0]))) == pytest.approx(9.0, abs=1.5)
+    for p in planes:  # normals face the camera centre
+        mid = p.to_world(np.mean(p.extent_u), np.mean(p.extent_v))
+        assert np.dot(p.n, np.array([1.0, 1.0, 1.2]) - mid) > 0
+
+
+def _ortho(img: np.ndarray, res: float = 0.005) -> Orthophoto:
+    h, w = img.shape[:2]
+    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
+                  (0.0, w * res), (0.0, h * res), w * h * res * res)
+    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+
+
+def test_cells_split_at_seams_and_between_handles() -> None:
+    """A 1.2 x 0.7 m panel (5 mm px): a dark seam at 0.4 m, a bright horizontal reflection line without
+    handles on both sides, and handles: one in the left cell, two side by side in the right part (the
+    seam between them is missing) -> three cells, one handle each; the reflection does not cut."""
+    h, w = 140, 240
+    rng = np.random.default_rng(0)
+    img = np.full((h, w, 3), 1.0, np.float32) + rng.normal(0, 0.004, (h, w, 3)).astype(np.float32)
+    img[:, 79:81] *= 0.85                      # seam at 0.4 m
+    img[70:72, :] *= 0.9                       # a reflected table edge (horizontal, whole width)
+    for c0 in (20, 110, 190):                  # horizontal bar handles near the top, 0.2 m x 0.02 m
+        img[15:19, c0:c0 + 40] = [1.8, 1.8, 1.8]
+    o = _ortho(img)
+    cov = np.ones((h, w), bool)
+    p = CellParams()
+    handles = find_handles(o, cov, p)
+    assert len(handles) == 3 and all(hd.horizontal for hd in handles)
+    cells = sorted(split_cells(o, cov, handles, p), key=lambda c: c.c0)
+    assert [len(c.handles) for c in cells] == [1, 1, 1]
+    assert abs(cells[0].c1 - 80) <= 2                       # the seam
+    assert 150 <= cells[1].c1 <= 190                        # between the two right handles
+    assert all(c.r0 == 0 and c.r1 == h for c in cells)      # the reflection line did not cut
+
+
+def test_find_fronts_no_candidate_gives_no_front() -> None:
+    """A mesh with no door-sized vertical facet (a floor) must give 0 fronts, not an einsum error."""
+    floor = _grid_mesh(0.0, 1.0, 0.0, 1.0, 0.0, 0.1, lambda x, z: np.full((len(x), 3), 100, np.uint8))
+    floor = TriMesh(floor.vertices[:, [0, 2, 1]], floor.faces, floor.colors)     # z = 0 plane
+    facets = planar_facets(floor)
+    assert find_fronts(floor, facets, np.ones(facets.n, bool), np.array([0.5, 0.5, 1.5])) == []
+
+
+def _seamless_cabinet_scene(scale: float = 1.0, shift_px: tuple[float, float] = (0.0, 0.0)):  # noqa: ANN202
+    """A 1.2 x 0.7 m flat run of two doors, no seam in the mesh: the gap and the handles exist only in
+    the vertex colours (like a TSDF scan, where the photos show what the mesh lost). Rendered from five
+    views; colour images may be rendered with a focal ``scale`` and a principal-point shift (an
+    unregistered colour camera)."""
+    def paint(x: np.ndarray, z: np.ndarray) -> np.ndarray:
+        c = np.tile(np.array([170, 40, 40], np.uint8), (len(x), 1))
+        c[np.abs(x - 0.6) < 0.006] = (60, 20, 20)                                  # the seam
+        for hx in (0.45, 0.75):                                                    # vertical bar handles
+            c[(np.abs(x - hx) < 0.012) & (z > 0.35) & (z < 0.55)] = (225, 225, 225)
+        return c
+    front = _grid_mesh(0.0, 1.2, 0.1, 0.8, 0.0, 0.006, paint)
+    wall = _grid_mesh(-0.5, 1.7, 0.0, 2.0, 0.6, 0.05, lambda x, z: np.full((len(x), 3), 200, np.uint8))
+    mesh = _merge(front, wall)
+    caster = RayCaster(mesh)
+    W, H = 480, 360
+    K = np.array([[400.0, 0, 240], [0, 400.0, 180], [0, 0, 1]])
+    Kc = K.copy()
+    Kc[:2, :2] *= scale
+    Kc[0, 2] += shift_px[0]
+    Kc[1, 2] += shift_px[1]
+    frames, images = [], {}
+    rng = np.random.default_rng(1)
+    for i, ex in enumerate((-0.3, 0.1, 0.6, 1.1, 1.5)):
+        c2w = look_at(np.array([ex, -1.6, 1.0]), np.array([0.6, 0.0, 0.45]))
+        fid = f"frame_{i:06d}"
+        images[fid] = caster.rgb(caster.cast(Kc, c2w, W, H), rng)
+        frames.append(Frame(frame_id=fid, rgb=ImageRef(path=Path(f"{fid}.png"), kind="png"),
+                            intrinsics=Intrinsics.from_K(K, W, H), pose=c2w))
+    return mesh, frames, images
+
+
+@pytest.mark.parametrize("scale, shift", [(1.0, (0.0, 0.0)), (0.92, (6.0, -4.0))])
+def test_seamless_mesh_splits_into_two_doors_from_the_images(scale: float, shift: tuple[float, float]) -> None:
+    mesh, frames, images = _seamless_cabinet_scene(scale, shift)
+    facets = planar_facets(mesh)
+    assert facets.n <= 4  # the mesh alone has no seam between the doors
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id])
+    fronts = sorted(res.fronts, key=lambda f: f.center[0])
+    assert len(fronts) == 2, [(np.round(f.center, 2), f.w, f.h) for f in fronts]
+    for f, (u0, u1) in zip(fronts, ((0.0, 0.6), (0.6, 1.2))):
+        cu = 0.5 * (f.extent_u[0] + f.extent_u[1])
+        assert abs(abs(cu) - 0.5 * (u0 + u1)) < 0.04 and abs(f.w - 0.6) < 0.06 and abs(f.h - 0.7) < 0.05
+        assert f.kind == "door" and f.articulation.joint_type == "revolute"
+        assert abs(f.articulation.axis[2]) > 0.99
+        hinge_x = f.articulation.origin[0]
+        # the handle is near the inner edges (0.45 / 0.75): hinges on the outer edges (0 / 1.2)
+        assert min(abs(hinge_x - 0.0), abs(hinge_x - 1.2)) < 0.04
+    if scale != 1.0:
+        assert res.calibration.scale == pytest.approx(scale, abs=0.03)
+    else:
+        assert res.calibration == ColourCalibration(before=res.calibration.before, after=res.calibration.after)
+
+
+def test_orthophoto_params_are_in_the_config() -> None:
+    from react3d_core.config import PipelineConfig
+    from react3d_core.perception.heuristic.image_fronts import params_from_config
+
+    cfg = PipelineConfig().with_overrides({"perception": {"heuristic": {"ortho_resolution": 0.006, "seam_span": 0.5}}})
+    p = params_from_config(cfg.perception.heuristic)
+    assert p.ortho.resolution == 0.006 and p.cells.seam_span == 0.5
+    assert OrthoParams().resolution == PipelineConfig().perception.heuristic.ortho_resolution
