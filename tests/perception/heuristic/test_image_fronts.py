@@ -172,3 +172,21 @@ def test_orthophoto_params_are_in_the_config() -> None:
     p = params_from_config(cfg.perception.heuristic)
     assert p.ortho.resolution == 0.006 and p.cells.seam_span == 0.5
     assert OrthoParams().resolution == PipelineConfig().perception.heuristic.ortho_resolution
+
+
+def test_frames_without_colour_fall_back_to_the_mesh_with_one_warning(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    """Colour frames that cannot be read give one warning line and the mesh-only fronts, never a crash."""
+    import logging
+
+    from react3d_core.data.frames import SceneInput
+    from react3d_core.data.mesh import save_mesh
+    from react3d_core.perception.heuristic import HeuristicModel
+
+    mesh, frames, _ = _seamless_cabinet_scene()
+    mesh_path = save_mesh(tmp_path / "mesh.ply", mesh)
+    scene = SceneInput(scene_id="s", root=tmp_path, mesh_path=mesh_path, frames=tuple(frames), source_format="generic")
+    with caplog.at_level(logging.WARNING, logger="react3d.perception"):
+        model = HeuristicModel(scene)
+    assert model.image is None and model.fronts == []   # the seamless mesh alone shows no front
+    warnings = [r for r in caplog.records if r.name == "react3d.perception"]
+    assert len(warnings) == 1 and "mesh only" in warnings[0].getMessage()
