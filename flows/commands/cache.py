@@ -20,7 +20,7 @@ def _roots() -> list:
 
     prefect_home = Path(os.environ.get("PREFECT_HOME", Path.home() / ".prefect"))
     storage = Path(os.environ.get("PREFECT_LOCAL_STORAGE_PATH", prefect_home / "storage"))
-    return [storage, cache_root() / "objects", cache_root() / "scenes"]
+    return [storage, cache_root() / "objects", cache_root() / "scenes", cache_root() / "quarantine"]
 
 
 def run(args: argparse.Namespace) -> int:
@@ -35,8 +35,12 @@ def run(args: argparse.Namespace) -> int:
         if not root.exists():
             console.print(f"{root}: empty")
             continue
-        entries = [p for p in root.rglob("*") if p.is_file()] if root.name != "scenes" else \
-            [p for p in root.glob("*/*") if p.is_dir()]
+        if root.name == "scenes":
+            entries = [p for p in root.glob("*/*") if p.is_dir()]
+        elif root.name == "quarantine":  # corrupt objects and folders moved aside, each with its seal
+            entries = list(root.iterdir())
+        else:
+            entries = [p for p in root.rglob("*") if p.is_file()]
         size = sum(p.stat().st_size for p in root.rglob("*") if p.is_file())
         if args.action == "info":
             console.print(f"{root}: {len(entries)} entries, {size / 1e6:.1f} MB")

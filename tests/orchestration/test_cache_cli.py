@@ -26,3 +26,24 @@ def test_cache_clean_older_than(tmp_path: Path, monkeypatch) -> None:  # noqa: A
     assert new_rec.exists()
     assert main(["cache", "clean"]) == 0
     assert not new_rec.exists()
+
+
+def test_cache_clean_prunes_the_quarantine(tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
+    """Corrupt objects and store folders moved to the quarantine are pruned like everything else."""
+    from flows.cli import main
+
+    monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("PREFECT_LOCAL_STORAGE_PATH", str(tmp_path / "storage"))
+    q = tmp_path / "cache" / "quarantine"
+    old_dir, new_obj = q / "export-ab12", q / "cd34.npz"
+    (old_dir / "urdf").mkdir(parents=True)
+    (old_dir / "urdf" / "scene.urdf").write_text("x")
+    (q / "export-ab12.seal.json").write_text("{}")
+    new_obj.write_text("x")
+    past = time.time() - 10 * 86400
+    for f in (old_dir, q / "export-ab12.seal.json"):
+        os.utime(f, (past, past))
+    assert main(["cache", "clean", "--older-than", "7"]) == 0
+    assert not old_dir.exists() and not (q / "export-ab12.seal.json").exists() and new_obj.exists()
+    assert main(["cache", "clean"]) == 0
+    assert not new_obj.exists()
