@@ -34,6 +34,7 @@ class CellParams:
     background_win: float = 0.12     # m: window of the local background for handles
     min_seen: float = 0.55           # a cell's mesh coverage fraction
     max_clutter: float = 0.18        # fraction of a cell's pixels off its local background (posters, tiles, shelves)
+    outline_margin: float = 0.02     # m: colour blobs this close to the plane's outline are not handles
     texture_factor: float = 3.0      # handle/seam thresholds rise to this many times the plane's median response
     max_depth: int = 6               # guillotine recursion depth
 
@@ -129,7 +130,10 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.nd
     diff = off_background(o, p) if diff is None else diff
     # textured fronts (wood grain) deviate everywhere: a handle stands out of the plane's own texture
     thr = max(p.handle_contrast, p.texture_factor * float(np.median(diff[valid])))
-    blob = ((diff > thr) & valid).astype(np.uint8)
+    # the plane's own outline (a worktop edge's shadow, the floor line) is no handle: keep 2 cm away
+    edge = max(1, int(round(p.outline_margin / o.res)))
+    inner = cv2.erode(coverage.astype(np.uint8), np.ones((2 * edge + 1, 2 * edge + 1), np.uint8)).astype(bool)
+    blob = ((diff > thr) & valid & inner).astype(np.uint8)
     if protrusion is not None:  # a handle that is in the mesh: its footprint in front of the plane
         blob |= protrusion.astype(np.uint8)
     # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
@@ -138,7 +142,7 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.nd
         cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
     blob = blob & ~cv2.dilate(strips, np.ones((3, 3), np.uint8))
     blob = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))  # cuts 1-2 px grain bridges
-    g = max(3, int(0.02 / o.res) | 1)  # a bar broken by a highlight is one handle
+    g = max(3, int(0.03 / o.res) | 1)  # a bar broken by a highlight is one handle
     blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
     n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=8)
     out = []

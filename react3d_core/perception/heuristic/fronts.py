@@ -32,6 +32,7 @@ class FrontRules:
     handle_max_area: float = 0.03     # m^2 of one handle facet
     handle_depth: tuple[float, float] = (0.002, 0.09)  # handle facets in front of the plane (m)
     drawer_max_h: float = 0.45          # deep drawers reach ~0.45 m; oven/dishwasher doors are >= 0.5 m
+    flap_min_top: float = 1.2           # a top-hinged flap lifts upwards: its top is above a worktop (m, z up from the floor)
     neighbour_gap: float = 0.03
     frame_max_width: float = 0.2      # stiles/rails of a frame-and-panel front (m)
     frame_depth: tuple[float, float] = (0.001, 0.03)  # frame pieces stand proud of a recessed panel ...
@@ -375,7 +376,7 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
     if (horizontal and f.h <= r.drawer_max_h) or (hpts is None and f.h <= r.drawer_max_h and (f.w >= f.h or stacked)):
         return "drawer", Articulation(joint_type="prismatic", axis=f.n_out, origin=centre, lower=0.0, upper=0.3,
                                       limit_source="heuristic")
-    if horizontal:
+    if horizontal and not (hcv < cv and f.extent_v[1] < r.flap_min_top):  # no flap lifts under a worktop
         low = hcv < cv
         edge_v = f.extent_v[1] if low else f.extent_v[0]  # flap: hinge on top; drop door: hinge at the bottom
         origin = on_plane(cu, edge_v)
@@ -397,9 +398,9 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
 
 
 def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None:
-    """Bottom- or top-hinged guesses ("drop", "flap") for fronts standing in a row with a same-height
-    neighbour whose horizontal bar handle is at the same height are cabinet doors with bar handles, not
-    ovens or flaps: appliances come one at a time and a flap has no door beside it with the same handle.
+    """Bottom-hinged guesses ("drop") for fronts standing in a row beside a front whose horizontal bar
+    handle is at the same height (± 10 cm) are cabinet doors with bar handles, not ovens: appliances
+    come one at a time. (Rows of flaps exist: wall cabinets are often all top-hinged.)
     Such fronts are re-typed as vertically hinged doors (hinge away from the neighbour of a pair, else
     left). Handles are those in ``handle_points`` (images) or the handle facets (mesh)."""
     def bar_height(f: Front) -> float | None:
@@ -410,13 +411,25 @@ def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None
 
     retype = []
     for f in fronts:
-        if f.kind not in ("drop", "flap") or bar_height(f) is None:
+        if f.kind != "drop" or bar_height(f) is None:
             continue
-        for g, side in _neighbours(f, fronts, rules):
+        for g in fronts:
             hg = bar_height(g)
-            if side in ("left", "right") and hg is not None and abs(hg - bar_height(f)) < 0.1:
-                retype.append(f)
-                break
+            if g is f or hg is None or not _side_by_side(f, g, rules) or abs(hg - bar_height(f)) >= 0.1:
+                continue
+            retype.append(f)
+            break
     for f in retype:
         f.kind, f.articulation = _joint(f, None, _neighbours(f, fronts, rules), rules)
         f.kind = "door"
+
+
+def _side_by_side(f: Front, g: Front, r: FrontRules) -> bool:
+    """Coplanar fronts touching left/right (gap < ``neighbour_gap``) whose heights overlap by >= 70 %
+    of the smaller one (image cells of one run differ by a few cm at top and bottom)."""
+    if np.dot(g.n_out, f.n_out) < 0.97 or abs(np.dot(g.center - f.center, f.n_out)) > 0.03:
+        return False
+    gu = (float(g.center @ f.u) - g.w / 2, float(g.center @ f.u) + g.w / 2)
+    gap = max(gu[0] - f.extent_u[1], f.extent_u[0] - gu[1])
+    ov = min(g.extent_v[1], f.extent_v[1]) - max(g.extent_v[0], f.extent_v[0])
+    return -0.01 <= gap < r.neighbour_gap and ov >= 0.7 * min(f.h, g.h)

@@ -141,7 +141,7 @@ def _cluttered(f: Front, orthos: Sequence[Orthophoto], params: ImageFrontParams)
     its rectangle in the orthophoto of its plane has more than ``max_clutter`` off-background pixels."""
     for o in orthos:
         p = o.plane
-        if np.dot(p.n, f.n_out) < 0.97 or abs(float(f.center @ p.n) - p.d) > 0.03:
+        if np.dot(p.n, f.n_out) < 0.97 or abs(float(f.center @ p.n) - p.d) > 0.08:
             continue
         h, w = o.n_views.shape
         c0, c1 = int((f.extent_u[0] - o.u0) / o.res), int(np.ceil((f.extent_u[1] - o.u0) / o.res))
