@@ -398,9 +398,10 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
 
 
 def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None:
-    """Bottom-hinged guesses ("drop") for fronts standing in a row beside a door-tall (>= 0.5 m) front
-    whose horizontal bar handle is at the same height (± 10 cm) are cabinet doors with bar handles, not ovens: appliances
-    come one at a time. (Rows of flaps exist: wall cabinets are often all top-hinged.)
+    """Bottom-hinged guesses ("drop") for fronts standing side by side with a door-tall (>= 0.5 m) front
+    that also carries a horizontal bar handle are cabinet doors with bar handles, not ovens: appliances
+    come one at a time. (Rows of flaps exist: wall cabinets are often all top-hinged. Bar heights are
+    not compared: a scan's bar detections stray by 10-60 cm, RedKitchen L2/L3.)
     Such fronts are re-typed as vertically hinged doors (hinge away from the neighbour of a pair, else
     left). Handles are those in ``handle_points`` (images) or the handle facets (mesh)."""
     def bar_height(f: Front) -> float | None:
@@ -415,8 +416,7 @@ def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None
             continue
         for g in fronts:
             hg = bar_height(g)
-            if (g is f or hg is None or g.h < 0.5 or not _side_by_side(f, g, rules)  # a drawer beside an oven: no row
-                    or abs(hg - bar_height(f)) >= 0.1):
+            if g is f or hg is None or g.h < 0.5 or not _side_by_side(f, g, rules):  # a drawer beside an oven: no row
                 continue
             retype.append(f)
             break
