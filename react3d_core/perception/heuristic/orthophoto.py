@@ -160,7 +160,7 @@ def _sample(img: np.ndarray, f: Frame, v: _View, c: ColourCalibration, gray: boo
     s = W / 640.0
     x = (c.scale * intr.fx * v.xn[..., 0] + intr.cx + c.dx * s).astype(np.float32)
     y = (c.scale * intr.fy * v.xn[..., 1] + intr.cy + c.dy * s).astype(np.float32)
-    src = cv2.cvtColor(img, cv2.COLOR_RGB2GRAY) if gray else img
+    src = (img if img.ndim == 2 else cv2.cvtColor(img, cv2.COLOR_RGB2GRAY)) if gray else img
     col = cv2.remap(src.astype(np.float32), np.where(v.ok, x, -1), np.where(v.ok, y, -1), cv2.INTER_LINEAR,
                     borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     inside = v.ok & (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
@@ -196,6 +196,8 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
             use.append([_View(v.frame, v.xn[::2, ::2], v.ok[::2, ::2]) for v in vs])
     if not use:
         return ColourCalibration()
+    gray = {v.frame: cv2.cvtColor(images[v.frame], cv2.COLOR_RGB2GRAY) for vs in use for v in vs}
+    images = gray  # every cost evaluation samples brightness only: convert each frame once
 
     def cost(c: ColourCalibration) -> float:
         vals = [_disagreement(vs, frames, images, c) for vs in use]
