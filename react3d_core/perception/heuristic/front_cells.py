@@ -260,6 +260,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         cut = lo + int(np.argmax(prof)) if len(prof) and prof.max() > 0.2 else (lo + hi) // 2
         a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1)
         b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1)
+        if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):
+            return [c]  # handles overlapping across the cut (a bar seen twice): nothing to separate
     else:
         hs = sorted(c.handles, key=lambda h: h.center[1])
         ys = [h.center[1] for h in hs]
@@ -271,4 +273,6 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         cut = lo + int(np.argmax(prof)) if len(prof) and prof.max() > 0.2 else (lo + hi) // 2
         a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1)
         b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1)
+        if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1):
+            return [c]
     return _split_handles(a, vert, horiz, cov, min_px) + _split_handles(b, vert, horiz, cov, min_px)

@@ -190,3 +190,18 @@ def test_frames_without_colour_fall_back_to_the_mesh_with_one_warning(tmp_path: 
     assert model.image is None and model.fronts == []   # the seamless mesh alone shows no front
     warnings = [r for r in caplog.records if r.name == "react3d.perception"]
     assert len(warnings) == 1 and "mesh only" in warnings[0].getMessage()
+
+
+def test_split_between_handles_ends_on_overlapping_bars() -> None:
+    """Two handle blobs whose boxes overlap, with seam evidence where the cut lands on the first
+    centre's integer column: the cut separates nothing and must end (it recursed until RecursionError
+    on a laser-scanned wardrobe)."""
+    from react3d_core.perception.heuristic.front_cells import Cell, Handle, _split_handles
+
+    h1 = Handle((100, 10, 201, 16), True, np.array([[100, 10]]))   # centre x 150.5
+    h2 = Handle((160, 40, 212, 46), True, np.array([[160, 40]]))   # centre x 186, box overlaps h1's
+    c = Cell(0, 0, 300, 200, [h1, h2])
+    ev = np.zeros((200, 300), bool)
+    ev[:, 150] = True
+    cells = _split_handles(c, ev, ev, np.ones((200, 300), bool), min_px=20)
+    assert sum(len(x.handles) for x in cells) == 2 and all(x.handles for x in cells)
