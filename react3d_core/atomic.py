@@ -66,7 +66,8 @@ def _sibling(path: Path, kind: str) -> Path:
     return path.with_name(f".{path.name}.{kind}-{os.getpid()}@{_HOST}-{secrets.token_hex(4)}")
 
 
-def _pid_alive(pid: int) -> bool:
+def pid_alive(pid: int) -> bool:
+    """Whether process ``pid`` runs on this host (a leftover of a dead run may be cleaned)."""
     if pid == os.getpid():
         return True
     try:
@@ -126,7 +127,7 @@ def clean_leftovers(path: str | Path, marked: bool) -> list[Path]:
         m = _LEFTOVER.match(p.name)
         if not m or m["name"] != path.name or p.is_symlink() or not p.is_dir():
             continue
-        if m["host"] not in (None, _HOST) or _pid_alive(int(m["pid"])):
+        if m["host"] not in (None, _HOST) or pid_alive(int(m["pid"])):
             continue
         if marked and not is_react3d_output(p):
             continue

@@ -24,7 +24,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any
 
-from react3d_core.atomic import atomic_path
+from react3d_core.atomic import atomic_path, pid_alive
 from react3d_core.errors import InputError
 
 from .serialize import dumps, loads
@@ -255,7 +255,7 @@ def sweep_stale(force: bool = False) -> list[Path]:
                     continue
                 m = _TMP_PID.match(p.name)
                 if m:
-                    if m["host"] not in (None, host) or _pid_alive(int(m["pid"])):
+                    if m["host"] not in (None, host) or pid_alive(int(m["pid"])):
                         continue
                 else:
                     try:
@@ -269,18 +269,6 @@ def sweep_stale(force: bool = False) -> list[Path]:
                     p.unlink(missing_ok=True)
                 removed.append(p)
     return removed
-
-
-def _pid_alive(pid: int) -> bool:
-    if pid == os.getpid():
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
 
 
 def file_sha256(path: str | Path, chunk: int = 1 << 20) -> str:
