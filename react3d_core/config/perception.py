@@ -33,7 +33,6 @@ class HeuristicConfig(StageConfig):
     ortho_resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
     max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
     calibrate_colour: bool = Field(True, description="Self-calibrate colour focal scale / principal point against the mesh (unregistered RGB-D).")
-    per_view_colour: bool = Field(False, description="Refine the colour calibration per view against the consensus of all views.")
     seam_contrast: float = Field(0.01, ge=0, description="A seam pixel is this much darker than both sides (fraction of the plane's mean).")
     seam_span: float = Field(0.35, ge=0, le=1, description="A seam covers this fraction of the cell it splits.")
     seam_prominence: float = Field(0.3, ge=0, le=1, description="... and this much more than the lines around it (vertical seams).")

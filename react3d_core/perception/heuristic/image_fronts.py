@@ -19,6 +19,7 @@ import numpy as np
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
+from .facets import face_normals
 from .front_cells import Cell, CellParams, find_handles, off_background, split_cells
 from .fronts import Front, FrontRules, _joint, _neighbours, doors_in_rows
 from .orthophoto import ColourCalibration, Orthophoto, OrthoParams, build_orthophotos
@@ -39,8 +40,7 @@ class ImageFrontParams:
 def params_from_config(cfg: "HeuristicConfig") -> ImageFrontParams:  # noqa: F821 - pydantic model
     """The image path's parameters from the pipeline config (every threshold lives there)."""
     return ImageFrontParams(
-        ortho=OrthoParams(resolution=cfg.ortho_resolution, max_views=cfg.max_views, calibrate=cfg.calibrate_colour,
-                          per_view=cfg.per_view_colour),
+        ortho=OrthoParams(resolution=cfg.ortho_resolution, max_views=cfg.max_views, calibrate=cfg.calibrate_colour),
         cells=CellParams(seam_contrast=cfg.seam_contrast, seam_span=cfg.seam_span, seam_prominence=cfg.seam_prominence,
                          seam_prominence_h=cfg.seam_prominence_h, handle_contrast=cfg.handle_contrast,
                          handle_len=tuple(cfg.handle_len), handle_thick=tuple(cfg.handle_thick)),
@@ -83,7 +83,7 @@ def cov_outline(cov: np.ndarray, px: int = 15) -> np.ndarray:
     return cv2.morphologyEx(cov.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((px, px), np.uint8)).astype(bool)
 
 
-def protrusion_map(o: Orthophoto, mesh: TriMesh, centroids: np.ndarray, normals: np.ndarray,
+def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
                    depth: tuple[float, float] = (0.012, 0.09)) -> np.ndarray:
     """Grid pixels under outward-facing faces standing ``depth`` in front of the plane (handles in
     the mesh), splatted by centroid and closed over 2 px."""
@@ -108,21 +108,22 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     planes = vertical_planes(mesh, cams.mean(0), max_tilt=rules.max_tilt, angle_tol_deg=params.plane_angle_tol_deg,
                              offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h))
     orthos, calib = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
-    tri = mesh.vertices[mesh.faces]
-    centroids = tri.mean(1)
-    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), 1e-15)
+    centroids = mesh.vertices[mesh.faces].mean(1)
+    normals, _ = face_normals(mesh)
     fronts: list[Front] = []
     for o in orthos:
         cov = coverage_map(o, mesh)
         o.n_views[~cov] = 0  # where the plane's own faces are not (floor, worktop edge seen at the same depth)
         diff = off_background(o, params.cells)
-        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, mesh, centroids, normals) & cov_outline(cov))
+        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals) & cov_outline(cov))
         clutter = (diff > params.cells.handle_contrast) & (o.n_views > 0)
         for h in handles:  # a handle is not clutter
             clutter[h.pixels[:, 1], h.pixels[:, 0]] = False
+        p = o.plane
+        rel = centroids - p.n * p.d
+        in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
         for cell in split_cells(o, cov, handles, params.cells):
-            f = _cell_front(o, cell, cov, clutter, centroids, rules, params, taken_faces)
+            f = _cell_front(o, cell, cov, clutter, in_plane, rules, params, taken_faces)
             if f is not None:
                 fronts.append(f)
     # a handle-less cell is a front only beside a front with a handle (tiles and splash-backs have none)
@@ -157,7 +158,7 @@ def _cluttered(f: Front, orthos: Sequence[Orthophoto], params: ImageFrontParams)
     return False
 
 
-def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, centroids: np.ndarray, rules: FrontRules,
+def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, in_plane: np.ndarray, rules: FrontRules,
                 params: ImageFrontParams, taken: np.ndarray | None) -> Front | None:
     """The front of one cell, or None when the cell is not door/drawer-like."""
     sub = cov[cell.r0:cell.r1, cell.c0:cell.c1]
@@ -177,8 +178,7 @@ def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray,
     if not cell.handles and (cell.cut_sides < 2 or max(w, h) < params.min_tile_side):
         return None  # a plain panel or a tile: not openable by these rules
     p = o.plane
-    rel = centroids - p.n * p.d
-    du, dv, dn = rel @ p.u, centroids[:, 2], rel @ p.n
+    du, dv, dn = in_plane[:, 0], in_plane[:, 1], in_plane[:, 2]
     inside = ((du > u_a) & (du < u_b) & (dv > v_a) & (dv < v_b)
               & (dn > params.face_depth[0]) & (dn < params.face_depth[1]))
     if taken is not None:

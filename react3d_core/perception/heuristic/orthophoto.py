@@ -42,9 +42,6 @@ class OrthoParams:
     scale_range: tuple[float, float] = (0.84, 1.12)
     shift_range_px: float = 16.0  # at 640 px image width
     min_gain: float = 0.2         # a calibration must cut the disagreement by this fraction to be used
-    per_view: bool = False        # then refine scale/shift per view against the consensus (RedKitchen: 6 -> 3 of 9 fronts, off)
-    view_shift_px: float = 12.0   # per-view search range around the scene's calibration (640 px width)
-    view_scale: float = 0.04
 
 
 @dataclass
@@ -136,11 +133,10 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         if any(v and v[-1].frame == fi for v in views):
             images[fi] = read_rgb(f)
     calib = _calibrate(views, frames, images, params) if params.calibrate else ColourCalibration()
-    per_view = _refine_views(views, frames, images, calib, params) if params.calibrate and params.per_view else {}
     out = []
     for i, p in enumerate(planes):
         pts, u0, v_top, res = grids[i]
-        stack = [_sample(images[v.frame], frames[v.frame], v, per_view.get(v.frame, calib)) for v in views[i]]
+        stack = [_sample(images[v.frame], frames[v.frame], v, calib) for v in views[i]]
         if stack:
             st = np.stack(stack)
             n = np.isfinite(st[..., 0]).sum(0)
@@ -223,55 +219,6 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
     if not np.isfinite(base) or best_cost > (1 - p.min_gain) * base:
         return ColourCalibration(before=base, after=base)
     return ColourCalibration(best.scale, best.dx, best.dy, base, best_cost)
-
-
-def _refine_views(views: list[list[_View]], frames: Sequence[Frame], images: dict[int, np.ndarray],
-                  calib: ColourCalibration, p: OrthoParams) -> dict[int, ColourCalibration]:
-    """Per view, the scale/shift near ``calib`` whose samples agree best (mean absolute difference)
-    with the consensus (median) of the other views, over every plane the view sees (every other grid
-    pixel). The colour camera of a hand-held RGB-D rig is not rigidly registered to its depth poses:
-    each frame is off by its own few pixels."""
-    sub = [[_View(v.frame, v.xn[::2, ::2], v.ok[::2, ::2]) for v in vs] for vs in views]
-    cons = []
-    for vs in sub:
-        if len(vs) >= 3:
-            st = np.stack([_sample(images[v.frame], frames[v.frame], v, calib, gray=True)[..., 0] for v in vs])
-            cons.append(_nanmedian(st))
-        else:
-            cons.append(None)
-    by_frame: dict[int, list[tuple[_View, np.ndarray]]] = {}
-    for vs, c in zip(sub, cons):
-        if c is None:
-            continue
-        for v in vs:
-            by_frame.setdefault(v.frame, []).append((v, c))
-    out = {}
-    for fi, pairs in by_frame.items():
-        def cost(c: ColourCalibration) -> float:
-            tot, n = 0.0, 0
-            for v, ref in pairs:
-                g = _sample(images[fi], frames[fi], v, c, gray=True)[..., 0]
-                m = np.isfinite(g) & (ref > 0)
-                if m.sum() < 50:
-                    continue
-                tot += float(np.abs(g[m] - ref[m]).sum())
-                n += int(m.sum())
-            return tot / n if n else float("inf")
-
-        best, best_cost = calib, cost(calib)
-        r, ds = p.view_shift_px, p.view_scale
-        steps = [[(0.0, dx, dy) for dx in np.linspace(-r, r, 5) for dy in np.linspace(-r, r, 5)],
-                 [(d, 0.0, 0.0) for d in np.linspace(-ds, ds, 5)],
-                 [(0.0, dx, dy) for dx in (-r / 4, 0, r / 4) for dy in (-r / 4, 0, r / 4)]]
-        for step in steps:
-            base = best
-            for d_s, dx, dy in step:
-                c = ColourCalibration(base.scale + d_s, base.dx + dx, base.dy + dy)
-                v = cost(c)
-                if v < best_cost:
-                    best, best_cost = c, v
-        out[fi] = best
-    return out
 
 
 def _nanmedian(stack: np.ndarray) -> np.ndarray:

@@ -14,6 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from ...data.mesh import TriMesh
+from .facets import face_normals
 
 
 @dataclass
@@ -69,11 +70,8 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
     ``cam_center``). Pieces of one plane separated by more than ``cell`` become separate planes."""
     if mesh.n_faces == 0:
         return []
-    t = mesh.vertices[mesh.faces]
-    nrm = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-    area = 0.5 * np.linalg.norm(nrm, axis=1)
-    nrm = nrm / np.maximum(2 * area, 1e-15)[:, None]
-    cen = t.mean(1)
+    nrm, area = face_normals(mesh)
+    cen = mesh.vertices[mesh.faces].mean(1)
     vert = (np.abs(nrm[:, 2]) <= max_tilt) & (area > 0)
     if not vert.any():
         return []
