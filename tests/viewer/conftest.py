@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import numpy as np
@@ -69,3 +70,22 @@ def toy_scene(tmp_path_factory: pytest.TempPathFactory) -> Path:
     InteractiveScene(scene_id="toy", input_mesh="scan.ply", background_mesh="meshes/background.ply", objects=objs,
                      timings={"fusion": 1.5, "export": 0.7}).save(out / "scene.json")
     return out
+
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+CHROMIUM_ARGS = [
+    "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-sandbox",
+    "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run",
+]
+
+
+@pytest.fixture(scope="module")
+def browser():  # noqa: ANN201 - playwright's Browser; modules using it skip when Chromium is absent
+    """Headless Debian Chromium (software GL) for the viewer tests."""
+    playwright = pytest.importorskip("playwright.sync_api", reason="playwright not installed")
+    if CHROMIUM is None:
+        pytest.skip("Debian chromium not installed (apt-get install chromium)")
+    with playwright.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS)
+        yield b
+        b.close()

@@ -16,18 +16,6 @@ playwright = pytest.importorskip("playwright.sync_api", reason="playwright not i
 if CHROMIUM is None:
     pytest.skip("Debian chromium not installed (apt-get install chromium)", allow_module_level=True)
 
-ARGS = [
-    "--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-sandbox",
-    "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run",
-]
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with playwright.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
 
 
 def _shot(page) -> np.ndarray:

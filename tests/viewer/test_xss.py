@@ -16,8 +16,6 @@ playwright = pytest.importorskip("playwright.sync_api", reason="playwright not i
 if CHROMIUM is None:
     pytest.skip("Debian chromium not installed (apt-get install chromium)", allow_module_level=True)
 
-ARGS = ["--no-sandbox", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--disable-gpu-sandbox",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync", "--no-first-run"]
 
 # each one sets a global when its markup is parsed as HTML instead of shown as text
 FRAME = 'frame<img src=x onerror="window.__pwned=(window.__pwned||[]).concat(\'frame\')">'
@@ -39,14 +37,6 @@ def hostile_scene(toy_scene: Path, tmp_path_factory: pytest.TempPathFactory) -> 
         o["articulation"]["limit_source"] = SOURCE
     (out / "scene.json").write_text(json.dumps(m))
     return out
-
-
-@pytest.fixture(scope="module")
-def browser():
-    with playwright.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
 
 
 def _open(browser, url: str):  # noqa: ANN001, ANN202
