@@ -81,3 +81,20 @@ def converted(scan: Path, cli_env: dict[str, str], tmp_path_factory: pytest.Temp
     r = run_cli(["convert", str(scan), "--out", str(out), *FAST], cli_env)
     assert r.returncode == 0, r.stderr[-3000:]
     return out
+
+
+def isolated_env(home: Path) -> dict[str, str]:
+    """Environment of a CLI run with nothing of the user's Prefect or react3d settings: its own Prefect
+    home, result storage and object store under ``home``."""
+    e = {k: v for k, v in os.environ.items() if not k.startswith(("PREFECT_", "REACT3D_"))}
+    e.update(PREFECT_HOME=str(home), PREFECT_LOCAL_STORAGE_PATH=str(home / "storage"),
+             REACT3D_CACHE=str(home / "react3d-cache"), PYTHONPATH=str(REPO),
+             PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS="300")
+    return e
+
+
+def convert_oracle_urdf(scene: Path, out: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """``react3d convert`` with oracle perception (fast, deterministic) and URDF export, in its own
+    process group; whatever the group leaves running (Prefect's temporary server) is ended afterwards."""
+    return run_cli(["convert", str(scene), "--out", str(out), "--perception", "oracle", "--stride", "2",
+                    "--formats", "urdf"], env, timeout=900)

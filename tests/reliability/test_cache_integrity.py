@@ -4,10 +4,8 @@ reaches a user's output; temporaries of killed runs are swept."""
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import os
-import signal
 import socket
 import hashlib
 import subprocess
@@ -19,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+from .conftest import convert_oracle_urdf as convert, isolated_env
 
 
 def _flip(path: Path, at: float = 0.5) -> None:
@@ -136,26 +134,8 @@ def test_stale_temporaries_of_killed_runs_are_swept(store: Path) -> None:
 
 @pytest.fixture(scope="module")
 def env(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
-    home = tmp_path_factory.mktemp("prefect-home")
-    e = {k: v for k, v in os.environ.items() if not k.startswith(("PREFECT_", "REACT3D_"))}
-    e.update(PREFECT_HOME=str(home), PREFECT_LOCAL_STORAGE_PATH=str(home / "storage"),
-             REACT3D_CACHE=str(home / "react3d-cache"), PYTHONPATH=str(ROOT),
-             PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS="300")
-    return e
+    return isolated_env(tmp_path_factory.mktemp("prefect-home"))
 
-
-def convert(scene: Path, out: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
-    """``react3d convert`` in its own process group; what the group leaves running is ended afterwards."""
-    p = subprocess.Popen([sys.executable, "-m", "flows.cli", "convert", str(scene), "--out", str(out),
-                          "--perception", "oracle", "--stride", "2", "--formats", "urdf"],
-                         env=env, cwd=ROOT, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         start_new_session=True)
-    try:
-        out_text, err_text = p.communicate(timeout=900)
-    finally:
-        with contextlib.suppress(ProcessLookupError, PermissionError):
-            os.killpg(p.pid, signal.SIGKILL)
-    return subprocess.CompletedProcess(p.args, p.returncode, out_text, err_text)
 
 
 def test_convert_recomputes_flipped_export_and_objects(synthetic_scene, env: dict[str, str], tmp_path: Path) -> None:  # noqa: ANN001

@@ -10,19 +10,14 @@ real ``react3d convert`` process on a real (temporary) Prefect server over them.
 from __future__ import annotations
 
 import base64
-import contextlib
 import json
-import os
 import pickle
-import signal
-import subprocess
-import sys
 import time
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[2]
+from .conftest import convert_oracle_urdf as convert, isolated_env
 
 
 class _Touch:
@@ -116,27 +111,8 @@ def test_forged_records_are_refused_before_decoding(tmp_path: Path, forge) -> No
 
 @pytest.fixture(scope="module")
 def env(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
-    home = tmp_path_factory.mktemp("prefect-home")
-    e = {k: v for k, v in os.environ.items() if not k.startswith(("PREFECT_", "REACT3D_"))}
-    e.update(PREFECT_HOME=str(home), PREFECT_LOCAL_STORAGE_PATH=str(home / "storage"),
-             REACT3D_CACHE=str(home / "react3d-cache"), PYTHONPATH=str(ROOT),
-             PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS="300")
-    return e
+    return isolated_env(tmp_path_factory.mktemp("prefect-home"))
 
-
-def convert(scene: Path, out: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
-    """``react3d convert`` in its own process group (oracle perception: fast, deterministic); whatever
-    the group leaves running (Prefect's temporary server) is ended afterwards."""
-    p = subprocess.Popen([sys.executable, "-m", "flows.cli", "convert", str(scene), "--out", str(out),
-                          "--perception", "oracle", "--stride", "2", "--formats", "urdf"],
-                         env=env, cwd=ROOT, text=True, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                         start_new_session=True)
-    try:
-        out_text, err_text = p.communicate(timeout=900)
-    finally:
-        with contextlib.suppress(ProcessLookupError, PermissionError):
-            os.killpg(p.pid, signal.SIGKILL)
-    return subprocess.CompletedProcess(p.args, p.returncode, out_text, err_text)
 
 
 def test_forged_records_in_shared_storage_do_not_run(synthetic_scene, env: dict[str, str], tmp_path: Path) -> None:  # noqa: ANN001
