@@ -111,10 +111,12 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     centroids = mesh.vertices[mesh.faces].mean(1)
     normals, _ = face_normals(mesh)
     fronts: list[Front] = []
+    diffs = []
     for o in orthos:
         cov = coverage_map(o, mesh)
         o.n_views[~cov] = 0  # where the plane's own faces are not (floor, worktop edge seen at the same depth)
         diff = off_background(o, params.cells)
+        diffs.append(diff)
         handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals) & cov_outline(cov))
         clutter = (diff > params.cells.handle_contrast) & (o.n_views > 0)
         for h in handles:  # a handle is not clutter
@@ -133,14 +135,15 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else None
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
-    vetoed = [k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, params)]
+    vetoed = [k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, params)]
     return ImageFronts(fronts, vetoed, planes, orthos, calib)
 
 
-def _cluttered(f: Front, orthos: Sequence[Orthophoto], params: ImageFrontParams) -> bool:
+def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarray], params: ImageFrontParams) -> bool:
     """A mesh front whose picture is cluttered (a tiled wall with a socket "handle") is not a front:
-    its rectangle in the orthophoto of its plane has more than ``max_clutter`` off-background pixels."""
-    for o in orthos:
+    its rectangle in the orthophoto of its plane has more than ``max_clutter`` off-background pixels
+    (``diffs``: each orthophoto's off-background map, computed once)."""
+    for o, diff_o in zip(orthos, diffs):
         p = o.plane
         if np.dot(p.n, f.n_out) < 0.97 or abs(float(f.center @ p.n) - p.d) > 0.08:
             continue
@@ -153,7 +156,7 @@ def _cluttered(f: Front, orthos: Sequence[Orthophoto], params: ImageFrontParams)
         seen = o.n_views[r0:r1, c0:c1] > 0
         if seen.sum() < 0.3 * seen.size:
             continue
-        diff = off_background(o, params.cells)[r0:r1, c0:c1]
+        diff = diff_o[r0:r1, c0:c1]
         return bool((diff[seen] > params.cells.handle_contrast).mean() > params.cells.max_clutter)
     return False
 
