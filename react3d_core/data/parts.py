@@ -159,6 +159,9 @@ class InteractiveScene(BaseModel):
     versions: dict[str, str] = Field(default_factory=dict)
     timings: dict[str, float] = Field(default_factory=dict)
     exports: dict[str, str] = Field(default_factory=dict, description="format -> path relative to the manifest")
+    export_sizes: dict[str, int] = Field(
+        default_factory=dict, description="bytes of export/: shared 'assets', each format's own files, and 'total'"
+    )
     created: str = Field(default_factory=lambda: datetime.now(timezone.utc).isoformat(timespec="seconds"))
 
     def save(self, path: str | Path) -> Path:
