@@ -1,4 +1,4 @@
-"""Hidden geometry behind a movable part: cavity depth d_in = min(d_image, d_hit, d_mesh), the base
+"""Hidden geometry behind a movable part: cavity depth d_in = min(d_image, d_hit, d_mesh, d_body), the base
 (an open, double-walled box behind the front) and, for drawers, an inner box that moves with the part.
 
 - d_hit: rays from the slab's mid-surface into the cavity (centre and 4 points at 0.1 x the longest
@@ -6,7 +6,12 @@
 - d_image: the farthest scene depth behind the front plane seen around the part in the segmenting frame
   (an upper bound: the wall behind a wall cabinet), used when at least two sides of that band mostly
   see behind it;
-- d_mesh: where the ray leaves the scan's bounding box.
+- d_mesh: where the ray leaves the scan's bounding box;
+- d_body: the furniture's own depth, for when nothing is seen behind it (a free-standing chest whose back
+  no camera saw: d_hit then reaches the room wall 2 m away and a drawer got 1.18 m of travel in a
+  0.37 m chest, issue 16). Rays cast straight up from points ever deeper behind the front hit the
+  carcass top (or the worktop) at about the same height while they are inside the furniture; the first
+  depth where the hit jumps up by ``body_jump_m`` (or vanishes) is past its back.
 Depths are measured from the slab's back face.
 """
 
@@ -20,7 +25,8 @@ from ..config import CavityConfig
 from ..data.frames import Frame
 from ..data.mesh import TriMesh
 
-STAGE_VERSION = "2"
+UP = np.array([0.0, 0.0, 1.0])  # world = scan frame, z up (data/frames.py conventions)
+STAGE_VERSION = "3"  # 3: d_body bounds the cavity by the furniture's own depth
 
 
 @dataclass
@@ -87,10 +93,41 @@ def d_image(pf: PartFrame, frame: Frame | None, depth: np.ndarray | None, cfg: C
     return float(behind.max())
 
 
+def d_body(pf: PartFrame, cast: callable, cfg: CavityConfig, up: np.ndarray = UP) -> float:  # type: ignore[valid-type]
+    """Depth behind the back face at which the furniture around the part ends (inf if not found).
+
+    Up-rays from 3 points across the part's width at depths ``body_step_m`` apart; the reference is the
+    median hit distance of the first three depths (inside the carcass); the body ends half a step
+    before the first depth whose median hit is ``body_jump_m`` higher or missing. Fronts facing up or
+    down (flaps in a worktop) have no such profile."""
+    up = np.asarray(up, float) / np.linalg.norm(up)
+    if abs(float(np.dot(pf.n, up))) > 0.5:
+        return np.inf
+    side = pf.u if abs(np.dot(pf.u, up)) <= abs(np.dot(pf.v, up)) else pf.v  # horizontal in-plane axis
+    width = pf.su if side is pf.u else pf.sv
+    start = max(cfg.ignore_hits_thickness_factor * pf.thickness, 0.02)
+    cs = np.arange(start, cfg.max_depth_m + cfg.body_step_m, cfg.body_step_m)
+    lat = np.array([-cfg.body_lateral_factor, 0.0, cfg.body_lateral_factor]) * width
+    origins = (pf.back + cs[:, None, None] * pf.n + lat[None, :, None] * side).reshape(-1, 3)
+    t = np.asarray(cast(origins, np.tile(up, (len(origins), 1))), float).reshape(len(cs), len(lat))
+    t = np.median(np.where(np.isfinite(t), t, np.inf), axis=1)
+    if len(t) < 4:
+        return np.inf
+    t0 = float(np.median(t[:3]))
+    if not np.isfinite(t0):
+        return np.inf  # nothing above the part: no carcass top to follow
+    out = np.flatnonzero(~(t <= t0 + cfg.body_jump_m))
+    out = out[out >= 3]
+    if len(out) == 0:
+        return np.inf
+    return float(cs[out[0]] - 0.5 * cfg.body_step_m)
+
+
 def estimate_cavity(pf: PartFrame, cast: callable, bounds: np.ndarray, frame: Frame | None,  # type: ignore[valid-type]
                     depth: np.ndarray | None, cfg: CavityConfig) -> tuple[float, str, dict[str, float]]:
-    """(d_in, which bound set it, all three bounds)."""
-    terms = {"hit": d_hit(pf, cast, cfg), "image": d_image(pf, frame, depth, cfg), "mesh": d_mesh(pf, bounds)}
+    """(d_in, which bound set it, all four bounds)."""
+    terms = {"hit": d_hit(pf, cast, cfg), "image": d_image(pf, frame, depth, cfg), "mesh": d_mesh(pf, bounds),
+             "body": d_body(pf, cast, cfg)}
     src = min(terms, key=terms.get)
     d = terms[src]
     if not np.isfinite(d) or d <= 0.02:
