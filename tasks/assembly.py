@@ -22,7 +22,7 @@ from react3d_core.config import ExportConfig, PipelineConfig
 
 from .keys import canonical, content_key, stage_version
 from .scene import scan_mesh, scene_input
-from .store import cache_root, get, seal_dir
+from .store import cache_root, get, relative, resolve, seal_dir
 
 
 def _dir_for(stage: str, inputs: Any) -> Path:
@@ -44,7 +44,7 @@ def assemble_body(scene_path: str, scene_sha: str, frames_cfg: dict[str, Any], p
     with atomic_dir(out) as tmp:
         assemble_scene(scene, scan_mesh(str(scene.mesh_path)), arts, cfg, tmp)
     seal_dir(out)  # cache hits are verified against it (tasks.store.verify_dir)
-    return {"sha256": out.name, "path": str(out / "scene.json"), "kind": "assembled-scene",
+    return {"sha256": out.name, "path": relative(out / "scene.json"), "kind": "assembled-scene",
             "seconds": time.perf_counter() - t0}
 
 
@@ -61,14 +61,14 @@ def export_body(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: 
     from react3d_core.export import export_scene
 
     t0 = time.perf_counter()
-    src = Path(assembled["path"]).parent
+    src = resolve(assembled["path"]).parent
     out = _dir_for("export", [assembled, export_cfg, formats, stage_version("react3d_core.export"),
                               stage_version("react3d_core.texture")])
     with atomic_dir(out) as tmp:
         shutil.copytree(src, tmp, dirs_exist_ok=True)
         export_scene(tmp / "scene.json", tuple(formats), ExportConfig.model_validate(export_cfg))
     seal_dir(out)
-    return {"sha256": out.name, "path": str(out / "scene.json"), "kind": "exported-scene",
+    return {"sha256": out.name, "path": relative(out / "scene.json"), "kind": "exported-scene",
             "seconds": time.perf_counter() - t0}
 
 
@@ -99,7 +99,7 @@ def fill_output(result: dict[str, Any], staging: str | Path, out_dir: str | Path
     ``out_dir`` (the same relative path from the staging sibling)."""
     from react3d_core.data.parts import InteractiveScene
 
-    src = Path(result["path"]).parent
+    src = resolve(result["path"]).parent
     staging, out = Path(staging), Path(out_dir)
     if staging.parent.resolve() != out.parent.resolve():
         raise ValueError(f"staging folder {staging} must be a sibling of {out}")

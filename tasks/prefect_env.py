@@ -32,6 +32,9 @@ def configure() -> None:
     """Apply the defaults that the user has not set."""
     for k, v in DEFAULTS.items():
         os.environ.setdefault(k, v)
+    from .storage import configure_result_storage
+
+    configure_result_storage()  # result records beside the shared store (REACT3D_STORE), issue 21
 
 
 # --- Result records: read only what react3d itself writes -------------------------------------------

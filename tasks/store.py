@@ -1,9 +1,10 @@
 """Content-addressed object store for task results: tasks return small *handles*, never arrays.
 
-A handle is ``{"sha256": ..., "path": ..., "kind": ...}``; the file lives under
-``$REACT3D_CACHE/objects/<aa>/<sha256>.npz`` (default ``~/.cache/react3d``), so a cached handle
-stays valid whatever output folder a later run writes to. Put the store on shared storage at the
-same absolute path for multi-machine workers. ``react3d cache clean`` prunes it with Prefect's records.
+A handle is ``{"sha256": ..., "path": ..., "kind": ...}`` with ``path`` relative to the store root
+(``objects/<aa>/<sha256>.npz``), so a cached handle stays valid whatever output folder a later run
+writes to and wherever a worker mounts the store. The store is chosen by ``REACT3D_STORE``
+(tasks/storage.py: a local folder, a shared mount, or ``s3://...`` mirrored in each worker's
+``REACT3D_CACHE``). ``react3d cache clean`` prunes the local folder with Prefect's records.
 
 Nothing read from the store is trusted blindly: objects are checked against their sha256 on every read,
 store folders (assembly, export) against the seal written beside them; a corrupt one is quarantined
@@ -27,11 +28,23 @@ from typing import Any
 from react3d_core.atomic import atomic_path, pid_alive
 from react3d_core.errors import InputError
 
+from . import storage
 from .serialize import dumps, loads
 
 
 def cache_root() -> Path:
-    return Path(os.environ.get("REACT3D_CACHE", Path.home() / ".cache" / "react3d"))
+    """This worker's local root of the store (see :func:`tasks.storage.cache_root`)."""
+    return storage.cache_root()
+
+
+def resolve(path: str | Path) -> Path:
+    """A handle's path on this worker: relative ones (current) under the store root, absolute ones as they are."""
+    return cache_root() / path
+
+
+def relative(path: Path) -> str:
+    """``path`` inside the store as the relative POSIX path that handles and records carry."""
+    return path.relative_to(cache_root()).as_posix()
 
 
 def put(obj: Any, kind: str) -> dict[str, str]:
@@ -50,7 +63,8 @@ def put(obj: Any, kind: str) -> dict[str, str]:
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
     _remember(path)
-    return {"sha256": sha, "path": str(path), "kind": kind}
+    storage.push_file(path, relative(path))
+    return {"sha256": sha, "path": relative(path), "kind": kind}
 
 
 def get(handle: dict[str, str], cache: bool = True) -> Any:
@@ -61,8 +75,8 @@ def get(handle: dict[str, str], cache: bool = True) -> Any:
     objects are kept per process: per-part tasks read the same perception results. ``cache=False``
     decodes without keeping it (a fan-in that reads every batch once).
     """
-    path = Path(handle["path"])
-    if not path.is_file():
+    path = resolve(handle["path"])
+    if not path.is_file() and not _pull_object(path):
         raise CorruptObjectError(path, f"cached {handle.get('kind', 'result')} is gone from the store; "
                                        "run `react3d cache clean` (drops stale records) and convert again")
     if not cache:
@@ -73,6 +87,21 @@ def get(handle: dict[str, str], cache: bool = True) -> Any:
 @lru_cache(maxsize=24)
 def _get_cached(sha: str, path: str) -> Any:
     return loads(_read_verified(Path(path), sha))
+
+
+def _pull_object(path: Path) -> bool:
+    """Fetch an object this worker lacks from the remote store (False: no remote, or not there either)."""
+    try:
+        return storage.pull_file(relative(path), path)
+    except ValueError:  # outside the store root
+        return False
+
+
+def _pull_dir(path: Path) -> bool:
+    try:
+        return storage.pull_dir(relative(path), path, SEAL_SUFFIX)
+    except ValueError:
+        return False
 
 
 def _read_verified(path: Path, sha: str) -> bytes:
@@ -165,6 +194,8 @@ def seal_dir(path: str | Path) -> Path:
     with atomic_path(seal) as tmp:
         tmp.write_text(json.dumps({"version": 1, "files": files}, indent=0), encoding="utf-8")
     _remember(path)
+    if storage.remote_root() is not None:
+        storage.push_dir(path, relative(path), seal)
     return seal
 
 
@@ -175,7 +206,7 @@ def verify_dir(path: str | Path) -> None:
     path = Path(path)
     if _unchanged_since_verified(path):
         return
-    if not path.is_dir():
+    if not path.is_dir() and not _pull_dir(path):
         raise CorruptObjectError(path, "cached folder is gone from the store")
     seal = path.with_name(path.name + SEAL_SUFFIX)
     try:
@@ -197,7 +228,7 @@ def verify_object(path: str | Path, sha: str) -> None:
     path = Path(path)
     if _unchanged_since_verified(path):
         return
-    if not path.is_file():
+    if not path.is_file() and not _pull_object(path):
         raise CorruptObjectError(path, "cached object is gone from the store")
     if path.name != f"{sha}.npz" or file_sha256(path) != sha:
         quarantine(path, "its bytes do not match its sha256")
@@ -221,7 +252,7 @@ def verify_handles(payload: Any) -> Any:
         if not isinstance(x, dict):
             continue
         if isinstance(x.get("sha256"), str) and isinstance(x.get("path"), str) and x.get("kind") != "rejected":
-            p = Path(x["path"])
+            p = resolve(x["path"])
             if not p.resolve().is_relative_to(root):
                 raise CorruptObjectError(p, f"cached result points outside the store {root}")
             if p.suffix == ".npz" and p.parent.parent.resolve() == root / "objects":

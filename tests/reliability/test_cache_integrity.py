@@ -39,12 +39,12 @@ def test_flipped_object_is_quarantined_then_healed_by_put(store: Path, caplog: p
 
     obj = {"masks": np.arange(5000, dtype=np.int32).reshape(50, 100), "name": "x"}
     h = put(obj, "perception")
-    _flip(Path(h["path"]))
+    _flip(store / h["path"])
     with caplog.at_level(logging.WARNING, logger="react3d.cache"), pytest.raises(CorruptObjectError) as e:
         get(h, cache=False)
     assert isinstance(e.value, InputError) and "quarantined" in str(e.value)  # one clear line, not BadZipFile
     assert len([r for r in caplog.records if r.name == "react3d.cache"]) == 1
-    assert not Path(h["path"]).exists() and len(list((store / "quarantine").iterdir())) == 1
+    assert not (store / h["path"]).exists() and len(list((store / "quarantine").iterdir())) == 1
     # the next run recomputes the same content: put() writes it again and it reads back intact
     assert put(obj, "perception") == h
     assert np.array_equal(get(h, cache=False)["masks"], obj["masks"])
@@ -54,7 +54,7 @@ def test_put_rewrites_a_corrupt_existing_object(store: Path) -> None:
     from tasks.store import get, put
 
     h = put([1, 2, 3], "candidates")
-    _flip(Path(h["path"]), 0.9)
+    _flip(store / h["path"], 0.9)
     put([1, 2, 3], "candidates")  # before: skipped because the file existed, so it never healed
     assert get(h, cache=False) == [1, 2, 3]
 
@@ -96,7 +96,7 @@ def test_record_pointing_at_a_corrupt_object_is_a_cache_miss(store: Path) -> Non
 
     h = put({"a": np.ones(100)}, "perception")
     verify_handles({**h, "seconds": 1.0})
-    _flip(Path(h["path"]))
+    _flip(store / h["path"])
     with pytest.raises(CorruptObjectError):
         verify_handles([{**h, "seconds": 1.0}])
     with pytest.raises(CorruptObjectError, match="outside the store"):
