@@ -1,12 +1,13 @@
 """Export stage: an InteractiveScene as URDF (PyBullet/ROS/Isaac importer), USD (PhysX) and MJCF (MuJoCo).
 
-``export_scene(manifest, formats, config)`` writes ``<out>/export/{urdf,usd,mjcf}``;
+``export_scene(manifest, formats, config)`` writes ``<out>/export/{assets,urdf,usd,mjcf}`` (meshes and
+textures once in ``assets``, referenced by every format);
 ``import_urdf(path)`` reads the articulations back for round trips.
 """
 
 from .importer import import_urdf
 from .scene import FORMATS, export_scene
 
-STAGE_VERSION = "1"
+STAGE_VERSION = "2"  # 2: one shared asset folder, binary USD, export_sizes (issue #18)
 
 __all__ = ["FORMATS", "STAGE_VERSION", "export_scene", "import_urdf"]

@@ -1,7 +1,10 @@
-"""Mesh files of an export: textured visuals (OBJ+MTL+PNG per folder, GLB) and convex collision OBJs.
+"""Mesh files of an export, written once and shared by every format.
 
-Vertices are written in link-local coordinates (world minus the link origin). Paths returned are
-relative to the format's folder, so the export can be moved as a whole.
+One asset folder per scene (``export/assets/<link>/``): textured visuals (OBJ+MTL+texture per
+folder, optional GLB) and convex collision OBJs. URDF, MJCF and USD reference these files with
+relative paths (``../assets/...`` from their own folders), so a 490k-face background is written
+once instead of once per format, and the export can be moved as a whole. Vertices are in
+link-local coordinates (world minus the link origin).
 """
 
 from __future__ import annotations
@@ -12,17 +15,28 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import atomic_path
+from ..config.export import ExportConfig
 from ..texture import write_glb, write_obj_folder
 from ..texture.writers import format_rows
 from .model import SceneModel
 
+ASSETS = "assets"
+"""Name of the shared asset folder inside ``export/``."""
+
 
 @dataclass
 class LinkFiles:
-    visuals: list[str] = field(default_factory=list)  # OBJ paths (each with its MTL/PNG beside it)
-    textures: list[str] = field(default_factory=list)  # PNG paths, same order
+    """Paths of one link's files, relative to the folder they were written under (see ``prefixed``)."""
+
+    visuals: list[str] = field(default_factory=list)  # OBJ paths (each with its MTL/texture beside it)
+    textures: list[str] = field(default_factory=list)  # texture paths, same order (the OBJ's own format)
+    mjcf_textures: list[str] = field(default_factory=list)  # PNG paths, same order (MuJoCo reads PNG only)
     collisions: list[str] = field(default_factory=list)  # convex OBJ per piece
     patches: list[str] = field(default_factory=list)  # background convex patches, one OBJ each
+
+    def prefixed(self, prefix: str) -> "LinkFiles":
+        """The same files seen from another folder (``prefix`` = ``"../"`` from ``export/<format>/``)."""
+        return LinkFiles(*([prefix + p for p in getattr(self, f)] for f in ("visuals", "textures", "mjcf_textures", "collisions", "patches")))
 
 
 def write_plain_obj(path: Path, vertices: np.ndarray, faces: np.ndarray) -> Path:
@@ -33,16 +47,27 @@ def write_plain_obj(path: Path, vertices: np.ndarray, faces: np.ndarray) -> Path
     return path
 
 
-def write_link_assets(model: SceneModel, folder: Path, glb: bool = True, collisions: bool = True) -> dict[str, LinkFiles]:
-    """Write every link's meshes under ``folder/meshes/<link>/``."""
+def write_link_assets(model: SceneModel, folder: Path, config: ExportConfig | None = None, glb: bool | None = None,
+                      collisions: bool = True, png_for_mjcf: bool = False, subdir: str = ASSETS) -> dict[str, LinkFiles]:
+    """Write every link's meshes under ``folder/<subdir>/<link>/``; paths returned are relative to ``folder``.
+
+    ``collisions``: also write the convex pieces and background patches as OBJ (URDF needs them;
+    MJCF and USD inline them). ``png_for_mjcf``: a JPEG texture gets a PNG copy for MuJoCo.
+    """
+    config = config or ExportConfig()
+    glb = config.write_glb if glb is None else glb
     out: dict[str, LinkFiles] = {}
     for link in model.links:
-        d = folder / "meshes" / link.name
+        d = folder / subdir / link.name
         files = LinkFiles()
         for k, tm in enumerate(link.visuals):
-            obj = write_obj_folder(tm, d / f"visual_{k}", offset=link.frame)
+            obj = write_obj_folder(tm, d / f"visual_{k}", offset=link.frame, texture=config.texture_format,
+                                   png_compression=config.png_compression, jpeg_quality=config.jpeg_quality,
+                                   png_copy=png_for_mjcf)
             files.visuals.append(obj.relative_to(folder).as_posix())
-            files.textures.append((obj.parent / "material_0.png").relative_to(folder).as_posix())
+            ext = "jpg" if config.texture_format == "jpg" else "png"
+            files.textures.append((obj.parent / f"material_0.{ext}").relative_to(folder).as_posix())
+            files.mjcf_textures.append((obj.parent / "material_0.png").relative_to(folder).as_posix())
             if glb:
                 write_glb(tm, d / f"visual_{k}.glb", offset=link.frame)
         if collisions:

@@ -11,11 +11,16 @@ Pieces thinner than ``min_collision_thickness`` become boxes that thick (a flat 
 
 from __future__ import annotations
 
+import hashlib
+import zipfile
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import trimesh
 
+from ..atomic import atomic_path
 from ..data.mesh import TriMesh
 
 MAX_HULL_VERTICES = 200  # PhysX caps a hull at 255 vertices by default
@@ -168,3 +173,48 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[Con
     corners = centre[:, None, :] + np.einsum("cj,gj,gij->gci", np.asarray(unit.vertices), ext, R)
     faces = np.asarray(unit.faces)
     return [ConvexPiece(c, faces, "patch") for c in corners]
+
+
+COLLISION_VERSION = "1"
+"""Bump when convex_pieces / planar_patches change their output: it is part of the cache key."""
+
+
+def _cache_key(kind: str, mesh: TriMesh, params: tuple) -> str:  # noqa: ANN401
+    h = hashlib.sha256(f"{kind}|{COLLISION_VERSION}|{params!r}|{len(mesh.vertices)}|{len(mesh.faces)}".encode())
+    h.update(np.ascontiguousarray(mesh.vertices, np.float64).tobytes())
+    h.update(np.ascontiguousarray(mesh.faces, np.int64).tobytes())
+    return h.hexdigest()
+
+
+def cached_pieces(cache_dir: str | Path | None, kind: str, mesh: TriMesh, params: tuple,
+                  compute: Callable[[], list[ConvexPiece]]) -> list[ConvexPiece]:
+    """``compute()`` keyed by the mesh's content and ``params`` in ``cache_dir`` (None: no cache).
+
+    Why: CoACD and the background patches depend only on the geometry and a few settings, so a
+    re-export (other formats, other texture budget) reads them back instead of recomputing. A file
+    that cannot be read is recomputed and rewritten (atomic write: never a half file)."""
+    if cache_dir is None:
+        return compute()
+    key = _cache_key(kind, mesh, params)
+    path = Path(cache_dir) / key[:2] / f"{kind}-{key}.npz"
+    if path.is_file():
+        try:
+            with np.load(path) as z:
+                counts_v, counts_f = z["counts_v"], z["counts_f"]
+                vs = np.split(z["vertices"], np.cumsum(counts_v)[:-1]) if len(counts_v) else []
+                fs = np.split(z["faces"], np.cumsum(counts_f)[:-1]) if len(counts_f) else []
+                return [ConvexPiece(v, f, str(s)) for v, f, s in zip(vs, fs, z["sources"])]
+        except (OSError, ValueError, KeyError, zipfile.BadZipFile):
+            pass  # unreadable: recompute below and overwrite
+    pieces = compute()
+    with atomic_path(path) as tmp:
+        with open(tmp, "wb") as fh:
+            np.savez(
+                fh,
+                vertices=np.concatenate([p.vertices for p in pieces]) if pieces else np.zeros((0, 3)),
+                faces=np.concatenate([p.faces for p in pieces]) if pieces else np.zeros((0, 3), np.int64),
+                counts_v=np.array([len(p.vertices) for p in pieces], np.int64),
+                counts_f=np.array([len(p.faces) for p in pieces], np.int64),
+                sources=np.array([p.source for p in pieces], dtype=str),
+            )
+    return pieces

@@ -34,7 +34,7 @@ def _inline_mesh(name: str, piece: ConvexPiece, frame: np.ndarray) -> str:
 
 def _assets(link: Link, files: LinkFiles) -> list[str]:
     out = []
-    for k, (obj, png) in enumerate(zip(files.visuals, files.textures)):
+    for k, (obj, png) in enumerate(zip(files.visuals, files.mjcf_textures)):
         n = f"{link.name}_visual_{k}"
         out += [
             f'    <mesh name="{n}" file={quoteattr(obj)}/>',
@@ -68,7 +68,7 @@ def _inertial(link: Link, indent: str) -> list[str]:
 
 
 def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConfig) -> str:
-    """The MJCF document (mesh and texture paths relative to its folder)."""
+    """The MJCF document (mesh and texture paths relative to its folder: ``../assets/...`` in an export)."""
     out = [
         f"<mujoco model={quoteattr(model.scene_id)}>",
         '  <compiler angle="radian" meshdir="." texturedir="." autolimits="true" inertiafromgeom="false"/>',

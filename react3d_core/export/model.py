@@ -19,7 +19,7 @@ from ..data.mesh import TriMesh, load_mesh
 from ..data.parts import Articulation, InteractiveScene
 from ..errors import InputError
 from ..texture import TexturedMesh, bake_texture
-from .collision import ConvexPiece, convex_pieces, planar_patches
+from .collision import ConvexPiece, cached_pieces, convex_pieces, planar_patches
 from .inertia import Inertial, inertial_from_pieces
 
 
@@ -70,19 +70,30 @@ def _mesh(root: Path, rel: str | None) -> TriMesh | None:
     return load_mesh(p)
 
 
-def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportConfig | None = None) -> SceneModel:
-    """Bake textures, decompose collisions and compute inertials for every link of ``scene``."""
+def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportConfig | None = None,
+                      cache_dir: str | Path | None = None) -> SceneModel:
+    """Bake textures, decompose collisions and compute inertials for every link of ``scene``.
+
+    ``cache_dir``: convex pieces and background patches are read from / written to it, keyed by mesh
+    content and settings (``collision.cached_pieces``); None computes them every time."""
     config = config or ExportConfig()
     root = Path(root)
     bg = _mesh(root, scene.background_mesh)
     assert bg is not None
+    thick = config.min_collision_thickness
+
+    def pieces_of(mesh: TriMesh, budget: int) -> list[ConvexPiece]:
+        return cached_pieces(cache_dir, "convex", mesh, (budget, thick), lambda: convex_pieces(mesh, budget, thick))
+
+    patches = cached_pieces(cache_dir, "patches", bg, (config.background_patch_m, thick),
+                            lambda: planar_patches(bg, config.background_patch_m, thick))
     links = [
         Link(
             "background",
             np.zeros(3),
             visuals=[bake_texture(bg, config)],
             static_mesh=bg,
-            patches=planar_patches(bg, config.background_patch_m, config.min_collision_thickness),
+            patches=patches,
             # static: the inertial only keeps importers from guessing (PyBullet warns, MuJoCo guesses density)
             inertial=Inertial(config.min_mass_kg, bg.vertices.mean(0), np.full(3, 1e-3), np.eye(3)),
         )
@@ -102,7 +113,7 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
         inner = _mesh(root, obj.inner_mesh)
         base = _mesh(root, obj.base_mesh)
         if base is not None:
-            pieces = convex_pieces(base, config.max_convex_hulls, config.min_collision_thickness)
+            pieces = pieces_of(base, config.max_convex_hulls)
             links.append(
                 Link(
                     f"{oid}__base", np.zeros(3), [bake_texture(base, config)], pieces,
@@ -114,7 +125,7 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
             parent = "background"
         moving = [m for m in (part, inner) if m is not None]
         budget = max(1, config.max_convex_hulls // len(moving))
-        pieces = [p for m in moving for p in convex_pieces(m, budget, config.min_collision_thickness)]
+        pieces = [p for m in moving for p in pieces_of(m, budget)]
         links.append(
             Link(
                 f"{oid}__part", np.asarray(art.origin, float), [bake_texture(m, config) for m in moving], pieces,

@@ -5,9 +5,12 @@ base rigid body fixed to the world, a part rigid body and its revolute/prismatic
 joint axes are only X/Y/Z, so both local joint frames are rotated to map +X onto the articulation
 axis (an axis near -X uses a half turn about Z, where the shortest-arc formula breaks down); body0's
 and body1's frames are the same world frame, so PhysX does not move bodies at load. Moving bodies
-get convex colliders only; the static background keeps its triangle mesh. Mesh data lives inside the
-stage (usd-core cannot reference OBJ/GLB); baked textures are PNGs beside it, bound through
-UsdPreviewSurface + UsdUVTexture + a ``st`` primvar reader.
+get convex colliders only; the static background collides through its own visual triangle mesh (one
+copy of the scan in the file, not two). Mesh data lives inside the stage (usd-core cannot reference
+OBJ/GLB), written as a binary crate ``scene.usdc`` (~4x smaller than ASCII) under a small
+``scene.usda`` root that carries the stage metadata and sublayers it. Textures are the shared
+export assets (``../assets/<link>/visual_<k>/material_0.png``), bound through UsdPreviewSurface +
+UsdUVTexture + a ``st`` primvar reader.
 """
 
 from __future__ import annotations
@@ -15,13 +18,12 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from ..atomic import atomic_path
 from ..config.export import ExportConfig
-from ..texture import TexturedMesh
+from .assets import LinkFiles
 from .collision import ConvexPiece
 from .model import Link, SceneModel
 
@@ -88,9 +90,11 @@ def _material(stage, name: str, texture_rel: str):  # noqa: ANN001, ANN202
     return mat
 
 
-def _visuals(stage, prim_path: str, link: Link, folder: Path) -> None:  # noqa: ANN001
+def _visuals(stage, prim_path: str, link: Link, files: LinkFiles) -> list:  # noqa: ANN001
+    """Textured visual meshes of ``link`` (textures: the shared asset files); returns the mesh prims."""
     from pxr import Sdf, UsdGeom, UsdShade, Vt
 
+    meshes = []
     for k, tm in enumerate(link.visuals):
         name = f"{link.name}_visual_{k}"
         # scan topology (shared points) with face-varying st: UV seams need no duplicated points
@@ -98,16 +102,9 @@ def _visuals(stage, prim_path: str, link: Link, folder: Path) -> None:  # noqa: 
         mesh = _define_mesh(stage, f"{prim_path}/{name}", tm.vertices[first] - link.frame, inv.reshape(-1)[tm.faces])
         st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.faceVarying)
         st.Set(Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(tm.uv[tm.faces].reshape(-1, 2), np.float32)))
-        rel = f"textures/{name}.png"
-        _write_png(folder / rel, tm)
-        UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(_material(stage, name, f"./{rel}"))
-
-
-def _write_png(path: Path, tm: TexturedMesh) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        if not cv2.imwrite(str(tmp), np.ascontiguousarray(tm.image[..., ::-1])):
-            raise OSError(f"cannot write {path}")
+        UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(_material(stage, name, files.textures[k]))
+        meshes.append(mesh)
+    return meshes
 
 
 def _colliders(stage, prim_path: str, pieces: list[ConvexPiece], frame: np.ndarray) -> None:  # noqa: ANN001
@@ -120,7 +117,7 @@ def _colliders(stage, prim_path: str, pieces: list[ConvexPiece], frame: np.ndarr
         UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.convexHull)
 
 
-def _body(stage, path: str, link: Link, folder: Path):  # noqa: ANN001, ANN202
+def _body(stage, path: str, link: Link, files: LinkFiles):  # noqa: ANN001, ANN202
     from pxr import UsdGeom, UsdPhysics
 
     xf = UsdGeom.Xform.Define(stage, path)
@@ -133,17 +130,35 @@ def _body(stage, path: str, link: Link, folder: Path):  # noqa: ANN001, ANN202
         mass.CreateCenterOfMassAttr(_vec3f(inn.com - link.frame))
         mass.CreateDiagonalInertiaAttr(_vec3f(inn.moments))
         mass.CreatePrincipalAxesAttr(_quatf(inn.axes))
-    _visuals(stage, path, link, folder)
+    _visuals(stage, path, link, files)
     _colliders(stage, path, link.collisions, link.frame)
     return xf
 
 
-def write_usd(model: SceneModel, path: str | Path, config: ExportConfig) -> Path:
-    """Write ``scene.usda`` (+ ``textures/``) for ``model``."""
+def _write_root(path: Path, data_name: str) -> None:
+    """The small ASCII root: stage metadata (read from the root layer only) and a sublayer to the crate."""
+    from pxr import Sdf, UsdGeom, UsdPhysics
+
+    layer = Sdf.Layer.CreateAnonymous(".usda")
+    layer.subLayerPaths.append(f"./{data_name}")
+    layer.defaultPrim = "World"
+    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.upAxis, UsdGeom.Tokens.z)
+    layer.pseudoRoot.SetInfo(UsdGeom.Tokens.metersPerUnit, 1.0)
+    layer.pseudoRoot.SetInfo(UsdPhysics.Tokens.kilogramsPerUnit, 1.0)
+    with atomic_path(path) as tmp:
+        if not layer.Export(str(tmp)):
+            raise OSError(f"cannot write {path}")
+
+
+def write_usd(model: SceneModel, path: str | Path, config: ExportConfig, files: dict[str, LinkFiles]) -> Path:
+    """Write the stage for ``model`` at ``path``; returns the file to open.
+
+    ``path`` ending in ``.usda`` with ``config.usd_binary``: the stage goes to ``scene.usdc`` beside
+    it and ``path`` becomes the small root (``config.usd_ascii_root``). Texture paths come from
+    ``files`` (relative to ``path``'s folder)."""
     from pxr import Gf, Sdf, Usd, UsdGeom, UsdPhysics
 
     path = Path(path)
-    folder = path.parent
     stage = Usd.Stage.CreateInMemory()
     UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.z)
     UsdGeom.SetStageMetersPerUnit(stage, 1.0)
@@ -156,12 +171,10 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig) -> Path
 
     bg = model.link("background")
     UsdGeom.Xform.Define(stage, "/World/background")
-    _visuals(stage, "/World/background", bg, folder)
-    if bg.static_mesh is not None:
-        col = _define_mesh(stage, "/World/background/collision", bg.static_mesh.vertices, bg.static_mesh.faces)
-        col.CreatePurposeAttr(UsdGeom.Tokens.guide)
-        UsdPhysics.CollisionAPI.Apply(col.GetPrim())
-        UsdPhysics.MeshCollisionAPI.Apply(col.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.none)
+    for mesh in _visuals(stage, "/World/background", bg, files["background"]):
+        # static triangle collider = the visual scan mesh itself (same triangles; no second copy)
+        UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
+        UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.none)
 
     for j in model.joints:
         oid = j.child[: -len("__part")]
@@ -173,7 +186,7 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig) -> Path
         body0: str | None = None
         if parent.role == "base":
             body0 = f"{root}/base"
-            _body(stage, body0, parent, folder)
+            _body(stage, body0, parent, files[parent.name])
             fixed = UsdPhysics.FixedJoint.Define(stage, f"{root}/base_fixed")
             fixed.CreateBody1Rel().SetTargets([Sdf.Path(body0)])
             fixed.CreateLocalPos0Attr(_vec3f(parent.frame))
@@ -181,7 +194,7 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig) -> Path
             fixed.CreateLocalPos1Attr(Gf.Vec3f(0, 0, 0))
             fixed.CreateLocalRot1Attr(Gf.Quatf(1.0))
         body1 = f"{root}/part"
-        _body(stage, body1, part, folder)
+        _body(stage, body1, part, files[part.name])
         a = j.articulation
         revolute = a.joint_type == "revolute"
         joint = (UsdPhysics.RevoluteJoint if revolute else UsdPhysics.PrismaticJoint).Define(stage, f"{root}/joint")
@@ -204,7 +217,11 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig) -> Path
             drive.CreateStiffnessAttr(0.0)
             drive.CreateDampingAttr(float(config.joint_damping / scale))  # per degree for revolute
             drive.CreateMaxForceAttr(float(config.joint_effort))
-    with atomic_path(path) as tmp:
+    # a .usdc path is the stage itself; a .usda path is the root over a crate (binary) or the stage (ASCII)
+    data = path.with_suffix(".usdc") if config.usd_binary else path
+    with atomic_path(data) as tmp:
         if not stage.GetRootLayer().Export(str(tmp)):
-            raise OSError(f"cannot write {path}")
+            raise OSError(f"cannot write {data}")
+    if data != path:
+        _write_root(path, data.name)
     return path

@@ -157,14 +157,20 @@ def _bake_cells(mesh: TriMesh, config: ExportConfig) -> TexturedMesh:
     pair = colors.reshape(cells, 2, 3, 3)
     img_cells = np.empty((rows * cols, s * s, 3), np.uint8)
     img_cells[cells:] = 180
-    wts = weights.astype(np.float32)
+    # each texel reads only its own triangle (A or B): two batched matmuls over the texels of that
+    # slot, instead of evaluating both triangles at every texel (einsum: 3x slower on a 490k-face scan)
+    sel = [np.flatnonzero(slot == k) for k in (0, 1)]
+    wts = [weights[ix].astype(np.float32) for ix in sel]  # (T_k, 3)
     step = max(1, 2_000_000 // (s * s))
+    vals = np.empty((min(step, cells), s * s, 3), np.float32)
     for c0 in range(0, cells, step):
         p = pair[c0 : c0 + step]  # (k,2,3,3)
-        vals = np.einsum("tv,kvd->ktd", wts, p[:, 0])
-        valsB = np.einsum("tv,kvd->ktd", wts, p[:, 1])
-        vals[:, slot == 1] = valsB[:, slot == 1]
-        img_cells[c0 : c0 + len(p)] = np.clip(np.rint(vals), 0, 255).astype(np.uint8)
+        v = vals[: len(p)]
+        for k in (0, 1):
+            v[:, sel[k]] = np.matmul(wts[k], p[:, k])  # (T_k,3) @ (k,3,3) -> (k,T_k,3)
+        np.rint(v, out=v)
+        np.clip(v, 0, 255, out=v)
+        img_cells[c0 : c0 + len(p)] = v
     img = img_cells.reshape(rows, cols, s, s, 3).transpose(0, 2, 1, 3, 4).reshape(H, W, 3)
     px = corners.reshape(-1, 2)
     uv = np.stack([px[:, 0] / W, 1.0 - px[:, 1] / H], 1)

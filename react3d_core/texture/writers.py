@@ -28,14 +28,30 @@ def format_rows(fmt: str, rows: np.ndarray) -> str:
     return (fmt * len(rows)) % tuple(rows.ravel().tolist())
 
 
-def write_obj_folder(tm: TexturedMesh, folder: str | Path, offset: np.ndarray | None = None) -> Path:
-    """Write ``folder/mesh.obj`` + ``material.mtl`` + ``material_0.png`` (trimesh's names), atomically.
+def encode_texture(image: np.ndarray, fmt: str = "png", png_compression: int = 3, jpeg_quality: int = 90) -> bytes:
+    """RGB uint8 image -> PNG or JPEG bytes (OpenCV's encoders: the fastest here, ~0.5 s for 2430^2 PNG)."""
+    import cv2
+
+    bgr = np.ascontiguousarray(np.asarray(image)[..., ::-1])
+    if fmt == "png":
+        ok, buf = cv2.imencode(".png", bgr, [cv2.IMWRITE_PNG_COMPRESSION, int(png_compression)])
+    elif fmt in ("jpg", "jpeg"):
+        ok, buf = cv2.imencode(".jpg", bgr, [cv2.IMWRITE_JPEG_QUALITY, int(jpeg_quality)])
+    else:
+        raise ValueError(f"unknown texture format {fmt!r} (png, jpg)")
+    if not ok:
+        raise OSError(f"cannot encode a {image.shape} texture as {fmt}")
+    return buf.tobytes()
+
+
+def write_obj_folder(tm: TexturedMesh, folder: str | Path, offset: np.ndarray | None = None, texture: str = "png",
+                     png_compression: int = 3, jpeg_quality: int = 90, png_copy: bool = False) -> Path:
+    """Write ``folder/mesh.obj`` + ``material.mtl`` + ``material_0.<png|jpg>`` (trimesh's names), atomically.
 
     Positions are written once per scan vertex and UVs once per atlas vertex (``f v/vt``), so the
     per-triangle atlas of a large scan does not triple the positions. Vertices are minus ``offset``.
+    ``png_copy`` adds ``material_0.png`` beside a JPEG texture (MuJoCo reads PNG only).
     """
-    import cv2
-
     from ..atomic import atomic_dir
 
     folder = Path(folder)
@@ -50,11 +66,13 @@ def write_obj_folder(tm: TexturedMesh, folder: str | Path, offset: np.ndarray | 
             fh.write(format_rows("v %.7g %.7g %.7g\n", v))
             fh.write(format_rows("vt %.7g %.7g\n", tm.uv))
             fh.write(format_rows("f %d/%d %d/%d %d/%d\n", corners))
+        ext = "jpg" if texture in ("jpg", "jpeg") else "png"
         (tmp / "material.mtl").write_text(
-            "newmtl material_0\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd material_0.png\n"
+            f"newmtl material_0\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd material_0.{ext}\n"
         )
-        if not cv2.imwrite(str(tmp / "material_0.png"), np.ascontiguousarray(tm.image[..., ::-1])):
-            raise OSError(f"cannot write {folder / 'material_0.png'}")
+        (tmp / f"material_0.{ext}").write_bytes(encode_texture(tm.image, ext, png_compression, jpeg_quality))
+        if png_copy and ext != "png":
+            (tmp / "material_0.png").write_bytes(encode_texture(tm.image, "png", png_compression))
     return folder / "mesh.obj"
 
 

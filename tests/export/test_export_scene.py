@@ -13,7 +13,10 @@ import pytest
 
 from react3d_core.data import InteractiveScene
 from react3d_core.errors import InputError
+from react3d_core.config.export import ExportConfig
 from react3d_core.export import export_scene, import_urdf
+
+FAST = ExportConfig(texel_per_m=100, write_glb=False)
 
 
 def test_manifest_records_exports(exported: dict[str, Path]) -> None:
@@ -23,11 +26,32 @@ def test_manifest_records_exports(exported: dict[str, Path]) -> None:
     for fmt, rel in scene.exports.items():
         assert (root / rel) == exported[fmt] and exported[fmt].is_file()
     urdf_dir = exported["urdf"].parent
+    assets = root / "export" / "assets"
     assert (urdf_dir / "display.launch.py").is_file() and (urdf_dir / "display.launch").is_file()
-    assert (urdf_dir / "meshes" / "drawer__part" / "visual_0.glb").is_file()
+    assert (assets / "drawer__part" / "visual_0.glb").is_file()
     # one folder per visual: trimesh's fixed MTL/PNG names never collide
     for link in ("background", "door__base", "door__part", "drawer__base", "drawer__part"):
-        assert (urdf_dir / "meshes" / link / "visual_0" / "material_0.png").is_file()
+        assert (assets / link / "visual_0" / "material_0.png").is_file()
+    # every mesh and texture is written once, in the shared assets: the format folders hold none
+    for fmt in ("urdf", "mjcf", "usd"):
+        own = [p for p in (root / "export" / fmt).rglob("*") if p.is_file() and "ros" not in p.parts]
+        assert not [p for p in own if p.suffix in (".obj", ".png", ".jpg", ".glb")], fmt
+    assert (root / "export" / "usd" / "scene.usdc").is_file()
+    sizes = scene.export_sizes
+    assert set(sizes) == {"assets", "urdf", "usd", "mjcf", "total"}
+    assert sizes["total"] >= sizes["assets"] + sizes["usd"] + sizes["mjcf"] and sizes["assets"] > 0
+
+
+def test_usd_root_is_small_and_sublayers_the_binary_stage(exported: dict[str, Path]) -> None:
+    from pxr import Sdf, Usd, UsdGeom
+
+    root = Sdf.Layer.FindOrOpen(str(exported["usd"]))
+    assert list(root.subLayerPaths) == ["./scene.usdc"] and root.GetFileFormat().formatId == "usda"
+    assert exported["usd"].stat().st_size < 2000
+    assert Sdf.Layer.FindOrOpen(str(exported["usd"].with_suffix(".usdc"))).GetFileFormat().formatId == "usdc"
+    stage = Usd.Stage.Open(str(exported["usd"]))
+    assert UsdGeom.GetStageUpAxis(stage) == "Z" and UsdGeom.GetStageMetersPerUnit(stage) == 1.0
+    assert stage.GetDefaultPrim().GetPath() == "/World"
 
 
 def test_round_trip_urdf_to_articulations(exported: dict[str, Path]) -> None:
@@ -119,7 +143,7 @@ def test_cell_atlas_path_loads_in_simulators(scene_dir: Path, tmp_path: Path) ->
     d = tmp_path / "scene"
     shutil.copytree(scene_dir, d)
     out = export_scene(d, formats=("urdf", "mjcf"), config=ExportConfig(xatlas_max_faces=1, texel_per_m=50, write_glb=False))
-    obj = out["urdf"].parent / "meshes" / "background" / "visual_0" / "mesh.obj"
+    obj = out["urdf"].parents[1] / "assets" / "background" / "visual_0" / "mesh.obj"
     text = obj.read_text()
     assert text.count("\nv ") == 13 * 13 + 9 * 9 and " 1/" in text  # scan positions once, UVs per corner
     model = mujoco.MjModel.from_xml_path(str(out["mjcf"]))
@@ -130,3 +154,53 @@ def test_cell_atlas_path_loads_in_simulators(scene_dir: Path, tmp_path: Path) ->
         assert pb.getNumJoints(body, physicsClientId=cid) == 5
     finally:
         pb.disconnect(cid)
+
+
+def test_collisions_are_cached_by_content_and_reused_by_a_reexport(scene_dir: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A second export (other formats, through the CLI) reads the decompositions back: the cached files
+    are not rewritten, and pieces come back identical. A changed mesh gets a new entry."""
+    from flows.cli import main
+
+    from react3d_core.export.collision import cached_pieces, convex_pieces
+
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("REACT3D_CACHE", str(cache))
+    d = tmp_path / "scene"
+    shutil.copytree(scene_dir, d)
+    export_scene(d, formats=("urdf",), config=FAST)
+    entries = sorted((cache / "collisions").rglob("*.npz"))
+    assert len(entries) == 1 + 2 + 3  # background patches; door base, part; drawer base, part, inner
+    stamps = {p: p.stat().st_mtime_ns for p in entries}
+    assert main(["export", str(d), "--formats", "mjcf,usd"]) == 0
+    assert sorted((cache / "collisions").rglob("*.npz")) == entries
+    assert {p: p.stat().st_mtime_ns for p in entries} == stamps  # read, not recomputed
+    from react3d_core.data import load_mesh
+
+    mesh = load_mesh(d / "meshes" / "drawer" / "inner.ply")
+    fresh = convex_pieces(mesh, 8, FAST.min_collision_thickness)
+    back = cached_pieces(cache / "collisions", "convex", mesh, (8, FAST.min_collision_thickness), lambda: [])
+    assert len(back) == len(fresh) and all(np.array_equal(a.vertices, b.vertices) and np.array_equal(a.faces, b.faces) for a, b in zip(back, fresh))
+    moved = mesh.__class__(mesh.vertices + 0.01, mesh.faces, mesh.colors)
+    assert cached_pieces(cache / "collisions", "convex", moved, (8, FAST.min_collision_thickness), lambda: []) == []
+
+
+def test_jpeg_textures_load_in_all_simulators(scene_dir: Path, tmp_path: Path) -> None:
+    """texture_format=jpg: URDF/USD read the JPEG, MuJoCo (PNG only) gets a PNG copy beside it."""
+    pb = pytest.importorskip("pybullet")
+    mujoco = pytest.importorskip("mujoco")
+    from react3d_core.config.export import ExportConfig
+    from react3d_core.export.usd_checks import check_usd
+
+    d = tmp_path / "scene"
+    shutil.copytree(scene_dir, d)
+    out = export_scene(d, config=ExportConfig(texel_per_m=100, texture_format="jpg", write_glb=False))
+    tex = d / "export" / "assets" / "door__part" / "visual_0"
+    assert (tex / "material_0.jpg").is_file() and (tex / "material_0.png").is_file()
+    assert "map_Kd material_0.jpg" in (tex / "material.mtl").read_text()
+    assert mujoco.MjModel.from_xml_path(str(out["mjcf"])).ntex >= 5
+    cid = pb.connect(pb.DIRECT)
+    try:
+        assert pb.getNumJoints(pb.loadURDF(str(out["urdf"]), useFixedBase=True, physicsClientId=cid), physicsClientId=cid) == 5
+    finally:
+        pb.disconnect(cid)
+    assert check_usd(out["usd"]) == []

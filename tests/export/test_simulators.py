@@ -159,7 +159,7 @@ def mj_part_pose(mujoco, model, data, name: str) -> np.ndarray:  # noqa: ANN001
 
 
 def mjcf_obj(mjcf: Path, link: str) -> Path:
-    return mjcf.parent / "meshes" / link / "visual_0" / "mesh.obj"
+    return mjcf.parents[1] / "assets" / link / "visual_0" / "mesh.obj"
 
 
 def test_mujoco_compiles_and_moves_parts(exported: dict[str, Path]) -> None:
