@@ -24,6 +24,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="Procedural room type (default: chosen by seed).")
     p.add_argument("--frames", type=int, default=60, help="Number of RGB-D frames to render.")
     p.add_argument("--urdf", default=None, help="Articulated URDF for --source urdf.")
+    p.add_argument("--up", default="z", choices=["z", "y", "x", "-z", "-y", "-x"],
+                   help="--source urdf: the asset's up axis, turned to the scene's +z (many exporters write y-up).")
+    p.add_argument("--scale", type=float, default=1.0,
+                   help="--source urdf: multiply the asset's lengths (and prismatic limits) by this (0.01 for centimetres).")
     p.add_argument("--preview", action="store_true", help="Also write preview.png (frames beside GT part ids).")
     p.add_argument("--edge", type=float, default=None, help="Furniture triangle size in metres (default 0.03 procedural, 0.05 others).")
     p.add_argument("--mesh", default="clean", choices=["clean", "laser", "tsdf"],
@@ -46,18 +50,21 @@ def run(args: argparse.Namespace) -> int:
 
     from react3d_core import __version__
     from react3d_core.atomic import OUTPUT_MARKER, check_output_dir
+    from react3d_core.errors import ConfigError
 
     if args.realism == "plain" and args.misregister != (0.0, 0.0):
-        from react3d_core.errors import ConfigError
-
         raise ConfigError("--misregister shifts the photo renderer's colour: it needs --realism photo")
+    if args.source != "urdf" and (args.up != "z" or args.scale != 1.0):
+        raise ConfigError("--up and --scale apply to --source urdf only")
+    if not (args.scale > 0 and args.scale < float("inf")):
+        raise ConfigError(f"--scale must be a positive number, got {args.scale}")
     check_output_dir(args.out, (args.urdf,) if args.urdf else (), kind="synth")  # never replace the user's files
     console = Console()
     t0 = time.perf_counter()
     with console.status(f"rendering {args.frames} frames ({args.source}, seed {args.seed})"):
         out = generate_scene(args.out, source=args.source, seed=args.seed, n_frames=args.frames,
                              urdf_path=args.urdf, kind=args.kind, edge=args.edge, mesh=args.mesh,
-                             realism=args.realism, misregister=args.misregister)
+                             realism=args.realism, misregister=args.misregister, up=args.up, scale=args.scale)
     # deterministic (hidden files stay out of scan fingerprints): lets a later synth replace this folder
     (Path(out) / OUTPUT_MARKER).write_text(json.dumps({"react3d": __version__, "kind": "synth"}))
     meta = json.loads((Path(out) / "synth_meta.json").read_text())
@@ -65,6 +72,8 @@ def run(args: argparse.Namespace) -> int:
         from react3d_core.synthetic.preview import write_preview
 
         console.print(f"preview: {write_preview(out)}")
+    for w in meta.get("up_warnings", []):
+        console.print(f"[yellow]warning:[/yellow] {w}", highlight=False)
     types = [p["type"] for p in meta["parts"]]
     console.print(f"[green]wrote[/green] {out}: {meta['kind']}, {meta['mesh']['kind']} mesh, {meta['faces']} faces, "
                   f"{meta['realism']} images, {meta['n_frames']} frames, "

@@ -28,15 +28,19 @@ def _room_depths(layout: SynthLayout) -> list[float]:
 
 def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 0, n_frames: int = 60,
                    urdf_path: str | Path | None = None, kind: str | None = None, edge: float | None = None,
-                   mesh: str = "clean", realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0)) -> Path:
+                   mesh: str = "clean", realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0),
+                   up: str = "z", scale: float = 1.0) -> Path:
     """Build, render and write one synthetic scene; returns ``out_dir``.
 
     ``kind`` picks the procedural room type (default by seed), ``edge`` the triangle size of the
     furniture (smaller = denser meshes, for scaling benchmarks; default 3 cm procedural, 5 cm others).
     ``mesh`` (clean | laser | tsdf) re-makes the written scan mesh like a real scan, ``realism``
     (photo | plain) picks the image renderer, ``misregister`` shifts colour against depth by (dx, dy)
-    pixels (see :func:`.writer.write_synthetic`).
+    pixels (see :func:`.writer.write_synthetic`). ``up`` / ``scale`` (urdf only): the asset's up axis
+    and unit scale (:func:`.from_urdf.build_from_urdf`).
     """
+    if source != "urdf" and (up != "z" or scale != 1.0):
+        raise ValueError("up/scale apply to source='urdf' only")
     edge = edge if edge is not None else (0.03 if source == "procedural" else 0.05)
     if source == "procedural":
         layout = build_room(seed, kind, edge=edge)
@@ -49,7 +53,7 @@ def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 
             raise ValueError("source='urdf' needs urdf_path")
         from .from_urdf import build_from_urdf
 
-        layout = build_from_urdf(Path(urdf_path), seed, edge=edge)
+        layout = build_from_urdf(Path(urdf_path), seed, edge=edge, up=up, scale=scale)
     else:
         raise ValueError(f"unknown source {source!r}; choose from {', '.join(SOURCES)}")
     return write_synthetic(layout, out_dir, n_frames, seed, source, room_depths=_room_depths(layout), mesh=mesh,

@@ -8,10 +8,17 @@ shell, and the camera sweeps every group of fronts that face the same way.
 
 Cavity depths are not known for arbitrary URDFs: ``interior_depth`` is None. Internal geometry that a
 capture of the closed scene never sees (drawer boxes, appliance insides) is culled (``observed.py``).
+
+``up`` names the asset's up axis (many exporters write Y-up) and ``scale`` its unit (0.01 for
+centimetres): the asset is rotated so that axis becomes the scene's +z and scaled, joints with it.
+Where the joints say otherwise (drawers that would slide vertically, hinges lying along another axis)
+a warning goes to the log and to ``synth_meta.json`` (``up_warnings``): a wrong up axis used to give a
+cabinet lying on its side without a word (issue 16).
 """
 
 from __future__ import annotations
 
+import logging
 import re
 import zlib
 from pathlib import Path
@@ -27,6 +34,49 @@ from .procedural import SynthLayout, ViewRun, shell
 
 SKIP = re.compile(r"basket|rack", re.I)  # internal sliding parts (dishwasher baskets) are not fronts
 MARGIN = 2.2  # free floor around the object(s), metres
+log = logging.getLogger(__name__)
+
+# proper rotations taking the named asset axis to +z (Y-up -> Z-up: +90 deg about x)
+UP_AXES: dict[str, np.ndarray] = {
+    "z": np.eye(3),
+    "-z": np.diag([1.0, -1.0, -1.0]),
+    "y": np.array([[1.0, 0, 0], [0, 0, -1], [0, 1, 0]]),
+    "-y": np.array([[1.0, 0, 0], [0, 0, 1], [0, -1, 0]]),
+    "x": np.array([[0.0, 0, -1], [0, 1, 0], [1, 0, 0]]),
+    "-x": np.array([[0.0, 0, 1], [0, 1, 0], [-1, 0, 0]]),
+}
+#: a joint axis within ~25 deg of a coordinate axis counts as lying along it
+ALONG = 0.9
+
+
+def up_axis_votes(joint_types: list[str], axes: np.ndarray) -> np.ndarray:
+    """Evidence for x, y, z (scene frame) being up: a hinge along an axis counts +1 (doors turn about
+    vertical hinges; oven doors and flaps do not, hence a small weight), a slide along it -2 (drawers and
+    sliding doors move horizontally)."""
+    votes = np.zeros(3)
+    for jt, ax in zip(joint_types, np.asarray(axes, float).reshape(-1, 3)):
+        along = np.abs(ax) / max(np.linalg.norm(ax), 1e-12) > ALONG
+        votes += np.where(along, 1.0 if jt == "revolute" else -2.0, 0.0)
+    return votes
+
+
+def up_warnings(joint_types: list[str], axes: np.ndarray, extents: np.ndarray, up: str) -> list[str]:
+    """Why the asset's up axis looks wrong after rotating ``up`` to +z (empty if it looks right)."""
+    names = "xyz"
+    axes = np.asarray(axes, float).reshape(-1, 3)
+    out = []
+    slides = [ax for jt, ax in zip(joint_types, axes) if jt == "prismatic"]
+    vertical = sum(abs(ax[2]) / max(np.linalg.norm(ax), 1e-12) > ALONG for ax in slides)
+    if slides and 2 * vertical > len(slides):
+        out.append(f"{vertical} of {len(slides)} prismatic joints would slide vertically")
+    votes = up_axis_votes(joint_types, axes)
+    best = int(np.argmax(votes))
+    if best != 2 and votes[best] >= votes[2] + 2:
+        out.append(f"the joints point to scene {names[best]} as up (score {votes[best]:g} vs {votes[2]:g} for z; "
+                   f"bounding box {' x '.join(f'{e:.2f}' for e in extents)} m)")
+    if out:
+        out.append(f"--up {up} may be wrong: try another --up (x, y, z, -x, -y, -z)")
+    return out
 
 
 def _subdivide(v: np.ndarray, f: np.ndarray, edge: float) -> tuple[np.ndarray, np.ndarray]:
@@ -46,10 +96,17 @@ def _color(geom, name: str) -> tuple[int, int, int]:  # noqa: ANN001
     return (120 + h % 100, 110 + (h // 7) % 100, 100 + (h // 49) % 100)
 
 
-def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "urdf") -> SynthLayout:
-    """Merge a closed URDF into a :class:`SynthLayout` with one GT part per movable joint."""
+def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "urdf", up: str = "z",
+                    scale: float = 1.0) -> SynthLayout:
+    """Merge a closed URDF into a :class:`SynthLayout` with one GT part per movable joint; ``up`` (a key
+    of :data:`UP_AXES`) is turned to +z and lengths are multiplied by ``scale``."""
     import yourdfpy
 
+    if up not in UP_AXES:
+        raise ValueError(f"unknown up axis {up!r}; choose from {', '.join(UP_AXES)}")
+    if not (np.isfinite(scale) and scale > 0):
+        raise ValueError(f"scale must be a positive number, got {scale}")
+    Rup = UP_AXES[up] * scale  # rotation then scale, for points and joint origins (axes: rotation only)
     path = Path(path)
     if not path.is_file():
         raise InputError(path, "URDF file not found")
@@ -89,7 +146,7 @@ def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "
         while link not in links and link in g.transforms.parents:
             link = g.transforms.parents[link]
         geom = sc.geometry[gname]
-        v = np.asarray(geom.vertices, float) @ T[:3, :3].T + T[:3, 3]
+        v = (np.asarray(geom.vertices, float) @ T[:3, :3].T + T[:3, 3]) @ Rup.T
         jn = owner(link)
         key = (jn + (".handle" if "handle" in node.lower() or "handle" in link.lower() else "")) if jn else f"static:{link}"
         pieces.setdefault(key, []).append((v, np.asarray(geom.faces, np.int64), _color(geom, node)))
@@ -116,11 +173,13 @@ def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "
         if SKIP.search(j.name) or j.name not in pieces:
             continue
         Tc = g.get(j.child)[0]
-        axis = Tc[:3, :3] @ np.asarray(j.axis, float)
-        origin = Tc[:3, 3] + offset
+        axis = UP_AXES[up] @ Tc[:3, :3] @ np.asarray(j.axis, float)
+        origin = Rup @ Tc[:3, 3] + offset
         q = q0_of.get(j.name, 0.0)
         lo_q = (j.limit.lower if j.limit is not None and j.limit.lower is not None else -np.pi) - q
         hi_q = (j.limit.upper if j.limit is not None and j.limit.upper is not None else np.pi) - q
+        if j.type == "prismatic":  # travel is a length: it scales with the asset
+            lo_q, hi_q = lo_q * scale, hi_q * scale
         if hi_q <= 1e-9:  # opens towards negative q: flip the axis so q in [0, upper] opens
             axis, lo_q, hi_q = -axis, -hi_q, -lo_q
         jt = "prismatic" if j.type == "prismatic" else "revolute"
@@ -131,9 +190,14 @@ def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "
         label = f"{parent_link}.{kind_}_{len(parts) + 1}"
         parts.append(PartSpec(j.name, label, kind_, art, pkey, j.name + ".handle" if j.name + ".handle" in pieces else None, None))
     mesh, keys, key_ids = m.build()
+    warn = up_warnings([p.articulation.joint_type for p in parts], np.array([p.articulation.axis for p in parts]),
+                       hi - lo, up)
+    for w in warn:
+        log.warning("%s: %s", path.name, w)
     runs = _runs(mesh, keys, key_ids, parts, W, L)
     return SynthLayout(mesh, keys, key_ids, parts, statics, runs, (W, L, H), kind,
-                       extra={"urdf": str(path.name), "offset": offset.tolist(), "skipped_joints": [j.name for j in movable if SKIP.search(j.name)]},
+                       extra={"urdf": str(path.name), "offset": offset.tolist(), "skipped_joints": [j.name for j in movable if SKIP.search(j.name)],
+                              "up": up, "scale": scale, "up_warnings": warn},
                        observed_only=True, face_materials=m.materials(), face_colors=m.base_colors())
 
 
