@@ -16,11 +16,11 @@ from ..data.masks import ArticulationPrediction
 from ..data.mesh import TriMesh
 from ..data.parts import OBB, Articulation, PartCandidate
 from .obb import min_obb
-from .refine import is_flat, refine_prismatic, refine_revolute, slab_mid_and_thickness
+from .refine import is_flat, refine_prismatic, refine_revolute, refine_sliding, slab_mid_and_thickness
 from .types import ArticulatedPart
 from .validate import best_prediction, lift_prediction
 
-STAGE_VERSION = "2"
+STAGE_VERSION = "3"  # 3: sliding (in-plane prismatic) predictions keep an in-plane axis
 __all__ = ["STAGE_VERSION", "ArticulatedPart", "PartFit", "articulate_candidate", "fit_part", "min_obb",
            "refine_articulation"]
 
@@ -49,12 +49,15 @@ def fit_part(points: np.ndarray, camera: np.ndarray, plane_normal: np.ndarray | 
     return PartFit(obb, n, mid, thickness, is_flat(obb, flat_ratio))
 
 
-def refine_articulation(initial: Articulation, fit: PartFit, refine: bool = True) -> Articulation:
-    """The paper's refinement on flat parts; ``refine=False`` (ablation) or a non-flat part keeps the prediction."""
+def refine_articulation(initial: Articulation, fit: PartFit, refine: bool = True, sliding: bool = False) -> Articulation:
+    """The paper's refinement on flat parts; ``refine=False`` (ablation) or a non-flat part keeps the prediction.
+
+    ``sliding``: the predictor says the prismatic part moves in its front plane (sliding door), so its
+    axis is snapped onto an in-plane side of the OBB instead of the front normal."""
     if not (refine and fit.flat):
         return initial
     if initial.joint_type == "prismatic":
-        return refine_prismatic(initial, fit.front_normal)
+        return refine_sliding(initial, fit.obb) if sliding else refine_prismatic(initial, fit.front_normal)
     return refine_revolute(initial, fit.obb, fit.mid_center)
 
 
@@ -90,10 +93,11 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
     cam = next((f.c2w[:3, 3] for f in scene.frames if f.frame_id == seg_id), frame.c2w[:3, 3])
     fit = fit_part(pts, cam, candidate.plane_normal, config.articulation.flat_ratio)
     obb, n, thickness, flat = fit.obb, fit.front_normal, fit.thickness, fit.flat
-    art = refine_articulation(initial, fit, config.articulation.refine)
+    sliding = bool(pred.sliding and pred.joint_type == "prismatic")
+    art = refine_articulation(initial, fit, config.articulation.refine, sliding)
     return ArticulatedPart(
         candidate_id=candidate.candidate_id, label=candidate.label, score=float(candidate.score * pred.score),
         face_ids=np.asarray(candidate.face_ids, np.int64), vertex_ids=np.asarray(candidate.vertex_ids, np.int64),
         initial=initial, articulation=art, obb=obb, front_normal=n, thickness=thickness, flat=flat,
         seg_frame_id=seg_id, top_views=[{"frame_id": v.frame_id, "iou": float(v.iou)} for v in candidate.top_views],
-        validation_iou=iou)
+        validation_iou=iou, sliding=sliding)

@@ -3,6 +3,10 @@
 With the part's OBB sides s1 >= s2 >= s3 along u1, u2, u3 and n the front normal (u1 x u2, oriented
 into the cavity):
 - prismatic: a' = sign(<a, n>) n, origin kept;
+- prismatic the predictor calls *sliding* (a sliding door moves in its front plane; issue 16): the
+  paper's rule would pull it straight out of the front, 90 deg off. Instead, like the revolute rule,
+  l = argmax_{v in {u1, u2}} |<a, v>| and a' = sign(<a, l>) l (on a vertical front with a horizontal
+  predicted motion: the front's horizontal in-plane edge), origin kept;
 - revolute: l = argmax_{v in {u1, u2}} |<a, v>|, a' = sign(<a, l>) l; the origin is the midpoint of
   the front-face edge parallel to l that is nearer to the predicted axis line, on the mid-surface
   between the slab's front and back faces.
@@ -27,6 +31,15 @@ def _sign(x: float) -> float:
 
 def refine_prismatic(a: Articulation, n: np.ndarray) -> Articulation:
     axis = _sign(float(np.dot(a.axis, n))) * np.asarray(n, float)
+    return a.model_copy(update={"axis": tuple(axis / np.linalg.norm(axis))})
+
+
+def refine_sliding(a: Articulation, obb: OBB) -> Articulation:
+    """Sliding (in-plane prismatic): snap onto the in-plane OBB side nearest the predicted axis, sign kept."""
+    R = obb.R
+    ax = np.asarray(a.axis, float)
+    l = R[:, 0] if abs(np.dot(ax, R[:, 0])) >= abs(np.dot(ax, R[:, 1])) else R[:, 1]
+    axis = _sign(float(np.dot(ax, l))) * l
     return a.model_copy(update={"axis": tuple(axis / np.linalg.norm(axis))})
 
 

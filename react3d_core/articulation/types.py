@@ -14,7 +14,9 @@ class ArticulatedPart:
     """A candidate that passed validation, with its initial (predicted) and refined joints.
 
     ``front_normal`` points from the front face into the cavity (away from the room);
-    ``thickness`` is the front slab's thickness along it (handles excluded).
+    ``thickness`` is the front slab's thickness along it (handles excluded); ``sliding``: a prismatic
+    part that moves in its front plane (sliding door), so assembly gives it no drawer box and a travel
+    along its own width.
     """
 
     candidate_id: int
@@ -31,3 +33,4 @@ class ArticulatedPart:
     seg_frame_id: str | None = None
     top_views: list[dict] = field(default_factory=list)
     validation_iou: float = 0.0
+    sliding: bool = False

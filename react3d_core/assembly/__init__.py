@@ -21,10 +21,10 @@ from ..cavity import PartFrame, base_mesh, estimate_cavity, inner_box_mesh
 from ..config import PipelineConfig
 from ..data.frames import SceneInput
 from ..data.mesh import TriMesh, save_mesh
-from ..data.parts import InteractiveObject, InteractiveScene, save_vertex_ids
+from ..data.parts import Articulation, InteractiveObject, InteractiveScene, save_vertex_ids
 from ..dedup import remove_duplicates
 
-STAGE_VERSION = "2"
+STAGE_VERSION = "3"  # 3: sliding doors: travel along their width, no drawer box
 __all__ = ["STAGE_VERSION", "assemble_scene", "carve_background"]
 
 
@@ -87,6 +87,16 @@ def carve_background(mesh: TriMesh, parts: list[ArticulatedPart], margin: float)
     return np.flatnonzero(~drop)
 
 
+def sliding_limits(a: Articulation, points: np.ndarray, margin: float, min_travel: float) -> Articulation:
+    """A sliding door keeps its predicted sign (it slides towards the door it overlaps; the cavity test of
+    ``set_limits`` cannot tell left from right in the front plane) and travels its own extent along the
+    axis less ``margin``: then it covers the neighbour it slid behind or in front of."""
+    ax = np.asarray(a.axis, float)
+    d = np.asarray(points, float) @ ax
+    extent = float(d.max() - d.min()) if len(d) else 0.0
+    return a.model_copy(update={"lower": 0.0, "upper": float(max(min_travel, extent - margin)), "limit_source": "sliding"})
+
+
 def _part_frame(mesh: TriMesh, p: ArticulatedPart) -> PartFrame:
     R = p.obb.R
     pts = mesh.vertices[p.vertex_ids]
@@ -119,13 +129,16 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
         dist = geo.distance_excluding(own, pf.center - pf.n * pf.thickness / 2, pf.n, with_points=True)
         own_faces = np.zeros(mesh.n_faces, bool)
         own_faces[p.face_ids] = True  # closed distances: everything but the part itself (gaps it glides along)
-        art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits, geo.distance_excluding(own_faces))
+        if p.sliding:
+            art = sliding_limits(p.articulation, pts, config.limits.prismatic_margin_m, config.limits.prismatic_min_m)
+        else:
+            art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits, geo.distance_excluding(own_faces))
         odir = out / "meshes" / oid
         part_mesh, _ = mesh.submesh(p.face_ids)
         save_mesh(odir / "part.ply", part_mesh)
         save_mesh(odir / "base.ply", base_mesh(pf, d_in, config.cavity))
         inner = None
-        if art.joint_type == "prismatic":
+        if art.joint_type == "prismatic" and not p.sliding:
             save_mesh(odir / "inner.ply", inner_box_mesh(pf, d_in, config.cavity, np.array([0.0, 0.0, 1.0])))
             inner = f"meshes/{oid}/inner.ply"
         save_vertex_ids(odir / "vertex_ids.npz", p.vertex_ids)

@@ -41,6 +41,10 @@ class HeuristicConfig(StageConfig):
     handle_len: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
     handle_thick: tuple[float, float] = Field((0.014, 0.07), description="Short side of a handle (m).")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
+    sliding_track_offset: tuple[float, float] = Field((0.008, 0.06), description="Sliding doors: plane offset between two side-by-side fronts on two tracks (m).")
+    sliding_max_overlap: float = Field(0.12, ge=0, description="Sliding doors: the two fronts' outlines overlap by at most this (m).")
+    sliding_max_gap: float = Field(0.02, ge=0, description="Sliding doors: ... or leave at most this gap between them (m).")
+    sliding_min_height_overlap: float = Field(0.9, ge=0, le=1, description="Sliding doors: share of the smaller height the two fronts share.")
 
 
 class PerceptionConfig(StageConfig):

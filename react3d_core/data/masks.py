@@ -45,6 +45,7 @@ class ArticulationPrediction(BaseModel):
     origin_cam: tuple[float, float, float] | None = None
     origin_px: tuple[float, float] | None = None
     score: float = 1.0
+    sliding: bool = Field(False, description="Prismatic motion in the front's plane (a sliding door), not out of it.")
 
 
 def save_masks(path: str | Path, masks: Sequence[Mask2D]) -> Path:

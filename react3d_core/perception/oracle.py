@@ -24,7 +24,7 @@ from ..errors import InputError
 from ..ground_truth import GroundTruth, read_articulate3d
 from .interfaces import Perception
 
-STAGE_VERSION = "1"
+STAGE_VERSION = "2"  # 2: says "sliding" for GT prismatic joints in the part's front plane
 REF_WIDTH = 960  # pixel sizes in OracleNoiseConfig are given at this image width
 
 
@@ -79,6 +79,7 @@ class OracleModel:
         self._cache: OrderedDict[str, np.ndarray] = OrderedDict()
         self._cache_size = cache
         self._raster = None
+        self._sliding: dict[int, bool] | None = None
 
     # -- pixels -------------------------------------------------------------------------------
     def part_image(self, frame: Frame) -> np.ndarray:
@@ -115,6 +116,27 @@ class OracleModel:
             self._raster, self._lut = Rasterizer(mesh), lut
         ids = self._raster.render_frame(frame).face_ids
         return self._lut[ids]
+
+    def sliding(self, pid: int) -> bool:
+        """GT prismatic joint in the part's own plane (a sliding door): the part is flat (its thinnest spread
+        under half the next) and the axis makes > 45 deg with its thinnest direction (the front normal:
+        the least-variance direction of its vertices). A drawer with its box in the GT is not flat."""
+        if self._sliding is None:
+            from ..data.mesh import load_mesh
+
+            verts = load_mesh(self.scene.mesh_path).vertices
+            self._sliding = {}
+            for p in self.gt.movable:
+                art, ids = p.articulation, p.vert_indices[(p.vert_indices >= 0) & (p.vert_indices < len(verts))]
+                if art is None or art.joint_type != "prismatic" or len(ids) < 4:
+                    self._sliding[p.part_id] = False
+                    continue
+                pts = verts[ids] - verts[ids].mean(0)
+                ev, vecs = np.linalg.eigh(pts.T @ pts)
+                flat = np.sqrt(max(ev[0], 0.0)) < 0.5 * np.sqrt(max(ev[1], 0.0))
+                in_plane = abs(float(np.dot(vecs[:, 0], art.axis))) < np.cos(np.radians(45.0))
+                self._sliding[p.part_id] = bool(flat and in_plane)
+        return self._sliding.get(pid, False)
 
     def part_region(self, img: np.ndarray, pid: int, with_handles: bool) -> np.ndarray:
         ids = [pid] + (self.handles.get(pid, []) if with_handles else [])
@@ -230,6 +252,7 @@ class OracleModel:
                     frame_id=frame.frame_id, mask=m, joint_type=jt,
                     axis_cam=tuple(float(x) for x in a_cam / np.linalg.norm(a_cam)),
                     origin_cam=tuple(float(x) for x in o_cam), score=1.0,
+                    sliding=jt == "prismatic" and art.joint_type == "prismatic" and self.sliding(pid),
                 )
             )
         return out

@@ -1,4 +1,5 @@
-"""Procedural furniture with real joints: cabinets (doors, drawers, top/bottom-hinged fronts), room doors.
+"""Procedural furniture with real joints: cabinets (doors, drawers, top/bottom-hinged fronts, sliding
+door pairs), room doors.
 
 Everything is built in a *wall frame*: x runs along the wall (left to right seen from the room),
 +y points into the wall (away from the room), z is up, and the furniture front lies at y = 0.
@@ -48,7 +49,7 @@ class PartSpec:
 
     key: str
     label: str
-    kind: str                      # door | drawer | flap (top-hinged) | drop (bottom-hinged) | room_door
+    kind: str                      # door | drawer | flap (top-hinged) | drop (bottom-hinged) | sliding | room_door
     articulation: Articulation
     parent_key: str | None
     handle_key: str | None = None
@@ -143,6 +144,34 @@ class Builder:
         self.parts.append(spec)
         return spec
 
+    def sliding_pair(self, frame: WallFrame, x0: float, x1: float, z0: float, z1: float, pal: Palette, handles: bool,
+                     carcass_key: str, depth: float, label_base: str, overlap: float = 0.04, track_gap: float = 0.015) -> None:
+        """Two sliding doors over [x0,x1]x[z0,z1] on two tracks: the left one on the outer (room-side) track,
+        the right one on the inner track, overlapping by ``overlap`` in the middle. Each slides in the front
+        plane towards the other (prismatic along +-x of the wall frame) by its width less the overlap.
+        Pulls are flat vertical bars near the outer edges, thinner than ``track_gap`` so a door passes
+        behind the other's pull."""
+        T = frame.T
+        xm = 0.5 * (x0 + x1)
+        inner_y = (-PROUD - FRONT, -PROUD)
+        outer_y = (inner_y[0] - track_gap - FRONT, inner_y[0] - track_gap)
+        doors = [(x0, xm + overlap / 2, outer_y, [1.0, 0.0, 0.0], x0 + 0.05),
+                 (xm - overlap / 2, x1, inner_y, [-1.0, 0.0, 0.0], x1 - 0.05)]
+        for a, b, (ya, yb), axis, hx in doors:
+            key = self._name(carcass_key + "_s")
+            self.mesh.add_box([a, ya, z0], [b, yb, z1], pal.front, key, T, material=pal.material)
+            travel = (b - a) - overlap
+            art = self._world_joint(frame, "prismatic", axis, [0.5 * (a + b), 0.5 * (ya + yb), 0.5 * (z0 + z1)], float(travel))
+            hkey = None
+            if handles:
+                hkey = key + ".handle"
+                ln, bar, proud = min(0.3, 0.5 * (z1 - z0)), 0.014, 0.01
+                zc = 0.5 * (z0 + z1)
+                self.mesh.add_box([hx - bar / 2, ya - proud, zc - ln / 2], [hx + bar / 2, ya, zc + ln / 2], pal.handle, hkey, T,
+                                  skip=((1, 1),), material=METAL)
+            self.parts.append(PartSpec(key, f"{label_base}.sliding_door_{len(self.parts) + 1}", "sliding", art, carcass_key,
+                                       hkey, depth))
+
     def carcass(self, frame: WallFrame, name: str, W: float, D: float, z0: float, H: float, shelves: list[float],
                 pal: Palette, plinth: float = 0.0) -> None:
         """Open-front box: two sides, top, bottom, back and horizontal dividers at heights ``shelves``."""
@@ -166,7 +195,7 @@ class Builder:
         """A carcass with a vertical stack of cells (bottom to top): (height fraction, layout).
 
         Layouts: ``drawer``, ``drawer2`` (two side by side), ``door_left``, ``door_right``, ``door2``
-        (a pair), ``flap``, ``drop``.
+        (a pair), ``flap``, ``drop``, ``slide2`` (a pair of sliding doors on two tracks).
         """
         name = self._name(label_base)
         fr = np.array([f for f, _ in cells], float)
@@ -177,7 +206,9 @@ class Builder:
         g = GAP / 2
         for (_, lay), za, zb in zip(cells, bounds[:-1], bounds[1:]):
             za_, zb_ = za + g, zb - g
-            if lay in ("door2", "drawer2"):
+            if lay == "slide2":
+                self.sliding_pair(frame, g, W - g, za_, zb_, pal, handles, name, depth, label_base)
+            elif lay in ("door2", "drawer2"):
                 xm = W / 2
                 kinds = ("door_left", "door_right") if lay == "door2" else ("drawer", "drawer")
                 self.front(frame, self._name(name + "_f"), kinds[0], g, xm - g, za_, zb_, pal, handles, name, depth, label_base)

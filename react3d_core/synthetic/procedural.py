@@ -16,7 +16,10 @@ from .builder import MeshBuilder
 from .furniture import PALETTES, Builder, PartSpec, WallFrame
 from .materials import STONE, WOOD
 
-KINDS = ("kitchen", "wardrobe", "dresser", "room_door", "mixed")
+KINDS = ("kitchen", "wardrobe", "dresser", "room_door", "mixed")  # the default kind is KINDS[seed % 5]
+# kinds only built when asked for (so the seed -> kind mapping of existing scenes stays as it was)
+EXTRA_KINDS = ("sliding",)
+ALL_KINDS = KINDS + EXTRA_KINDS
 WALL_T = 0.12
 
 
@@ -163,12 +166,30 @@ def _dresser(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
     runs.append(ViewRun(fr, x0, x, 0.08, 0.08 + Hd, D))
 
 
+def _sliding(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun], H: float) -> None:
+    """A low sideboard / TV cabinet with a pair of sliding doors (above a drawer row half the time) and a
+    sliding-door wardrobe beside it: sliding doors with GT joints in the front plane (issue 16)."""
+    pal = PALETTES[int(rng.integers(len(PALETTES)))]
+    handles = bool(rng.random() < 0.8)
+    D, Hs, w = float(rng.uniform(0.4, 0.48)), float(rng.uniform(0.55, 0.8)), float(rng.uniform(1.2, 1.6))
+    x0 = float(rng.uniform(0.15, 0.35))
+    cells = [(0.25, "drawer2"), (0.75, "slide2")] if rng.random() < 0.5 else [(1.0, "slide2")]
+    b.cabinet(fr.shifted(x0, -D), w, D, 0.08, Hs, cells, pal, handles, "sideboard", plinth=0.08)
+    x, z1, depth = x0 + w, 0.08 + Hs, D
+    ww = float(rng.uniform(1.4, 1.8))
+    if x + 0.1 + ww < length - 0.1:
+        Dw, Ht = float(rng.uniform(0.58, 0.65)), float(min(H - 0.15, rng.uniform(1.9, 2.2)))
+        b.cabinet(fr.shifted(x + 0.1, -Dw), ww, Dw, 0.05, Ht - 0.05, [(1.0, "slide2")], pal, handles, "wardrobe", plinth=0.05)
+        x, z1, depth = x + 0.1 + ww, Ht, Dw
+    runs.append(ViewRun(fr, x0, x, 0.08, z1, depth))
+
+
 def build_room(seed: int, kind: str | None = None, edge: float = 0.03) -> SynthLayout:
     """A seeded room of the given kind (default: chosen by seed)."""
     rng = np.random.default_rng(seed)
     kind = kind or KINDS[seed % len(KINDS)]
-    if kind not in KINDS:
-        raise ValueError(f"unknown scene kind {kind!r}; choose from {', '.join(KINDS)}")
+    if kind not in ALL_KINDS:
+        raise ValueError(f"unknown scene kind {kind!r}; choose from {', '.join(ALL_KINDS)}")
     W, L, H = float(rng.uniform(3.4, 4.6)), float(rng.uniform(3.8, 5.2)), float(rng.uniform(2.5, 2.8))
     m = MeshBuilder(edge=edge, seed=seed)
     b = Builder(m, rng)
@@ -191,6 +212,7 @@ def build_room(seed: int, kind: str | None = None, edge: float = 0.03) -> SynthL
         "dresser": [(0, _dresser)],
         "room_door": [(0, _dresser), (1, _wardrobe)],
         "mixed": [(0, _kitchen), (1, _wardrobe), (3, _dresser)],
+        "sliding": [(0, _sliding), (1, _dresser)],
     }[kind]
     for k, fn in plan:
         fr, length = frames[k]

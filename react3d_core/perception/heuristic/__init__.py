@@ -4,7 +4,8 @@ Two sources of fronts: planar facets of the mesh (seams between fronts separate 
 vertical, rectangular, door/drawer-sized and carry a handle (fronts.py), and — where the mesh has no
 seams, as in real scans — the colour frames: each large vertical plane is fused into an orthophoto
 from all views that see it and split at the seams and between the handles it shows
-(image_fronts.py). The joint comes from shape and handle. All five perception calls read per-frame
+(image_fronts.py). The joint comes from shape and handle; two equally tall fronts side by side a track
+apart (one a few cm in front of the other) are a pair of sliding doors (sliding.py). All five perception calls read per-frame
 renders of these fronts (docs/perception.md states the limits).
 """
 
@@ -17,14 +18,18 @@ from .backend import (HeuristicArticulation, HeuristicModel, HeuristicPointSegme
                       HeuristicTagger, KeepOpenable)
 from .fronts import FrontRules
 from .image_fronts import params_from_config
+from .sliding import SlidingRules
 
-STAGE_VERSION = "3"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames
+STAGE_VERSION = "4"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames; 4: sliding doors
 
 
 def make_heuristic(scene: SceneInput, config: PerceptionConfig) -> Perception:
     """Build the heuristic backend for ``scene`` (facets and fronts are computed once here)."""
     image = params_from_config(config.heuristic) if config.heuristic.image_fronts else None
-    model = HeuristicModel(scene, FrontRules(), image=image)
+    h = config.heuristic
+    sliding = SlidingRules(track_offset=tuple(h.sliding_track_offset), max_overlap=h.sliding_max_overlap,
+                           max_gap=h.sliding_max_gap, min_height_overlap=h.sliding_min_height_overlap)
+    model = HeuristicModel(scene, FrontRules(), image=image, sliding=sliding)
     return Perception(name="heuristic", tagger=HeuristicTagger(model), tag_filter=KeepOpenable(),
                       segmenter=HeuristicSegmenter(model), point_segmenter=HeuristicPointSegmenter(model),
                       articulation=HeuristicArticulation(model), version=STAGE_VERSION)

@@ -22,6 +22,7 @@ from ...scene_io.images import frame_rgb
 from .facets import planar_facets
 from .fronts import Front, FrontRules, find_fronts
 from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts
+from .sliding import SlidingRules, mark_sliding
 
 log = logging.getLogger("react3d.perception")
 
@@ -33,7 +34,7 @@ class HeuristicModel:
     """Facets, fronts and per-frame renders of one scene."""
 
     def __init__(self, scene: SceneInput, rules: FrontRules = FrontRules(), scale: float = 0.5, n_probe: int = 24,
-                 image: ImageFrontParams | None = ImageFrontParams()) -> None:
+                 image: ImageFrontParams | None = ImageFrontParams(), sliding: SlidingRules | None = SlidingRules()) -> None:
         self.scene = scene
         self.mesh: TriMesh = load_mesh(scene.mesh_path)
         self.raster = Rasterizer(self.mesh)
@@ -51,6 +52,8 @@ class HeuristicModel:
             self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, rules, image, taken,
                                            self.fronts)
             self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
+        if sliding is not None:
+            mark_sliding(self.fronts, sliding)  # two fronts a track apart: sliding doors
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
         for i, fr in enumerate(self.fronts):
             self.face_front[fr.faces] = i
@@ -192,6 +195,7 @@ class HeuristicArticulation:
                 axis = w2c[:3, :3] @ np.asarray(a.axis)
                 origin = w2c[:3, :3] @ np.asarray(a.origin) + w2c[:3, 3]
                 preds.append(ArticulationPrediction(frame_id=f.frame_id, mask=m, joint_type=a.joint_type,
-                                                    axis_cam=tuple(axis), origin_cam=tuple(origin), score=0.7))
+                                                    axis_cam=tuple(axis), origin_cam=tuple(origin), score=0.7,
+                                                    sliding=self.model.fronts[k].kind == "sliding"))
             out.append(preds)
         return out
