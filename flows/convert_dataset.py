@@ -1,14 +1,22 @@
-"""Flow ``convert_dataset``: many scenes, each a subflow; one failed scene never fails the others.
+"""Flow ``convert_dataset``: many scenes; one failed scene never fails the others.
 
-Scenes run ``scene_concurrency`` at a time (threads in this process; for process isolation on a
-cluster use the deployment in deployments/prefect.yaml, one flow run per scene). The run ends with a
-table artifact of succeeded/failed scenes with reasons, and returns the same rows.
+Two modes. Embedded (default, ``deployment=None``): scenes are subflows in threads of this process,
+``scene_concurrency`` at a time. Distributed (``deployment="react3d-convert-scene/convert-scene"``):
+one flow run per scene through that deployment (``run_deployment``, non-blocking), at most
+``scene_concurrency`` in flight, so every worker of the pool takes scenes; a run that *crashed* (its
+worker or machine died, OOM kill; marked Crashed by the worker or by the zombie automation of
+deployments/setup.py) is submitted again, up to ``max_attempts`` runs in all, and resumes from the cached
+tasks in the shared store on whichever worker picks it up; a run that *failed* (bad input, a bug) is
+reported once with its reason. Both modes end with the same table artifact (ok / failed with reason /
+retries) and return its rows (docs/orchestration.md).
 """
 
 from __future__ import annotations
 
 import fnmatch
+import json
 import time
+from collections import deque
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import Any
@@ -21,6 +29,7 @@ from prefect import flow  # noqa: E402
 
 from react3d_core.atomic import check_output_dir  # noqa: E402
 from react3d_core.errors import InputError  # noqa: E402
+from tasks import storage  # noqa: E402
 from tasks.assembly import OUTPUT_KIND  # noqa: E402
 
 from .convert_scene import convert_scene  # noqa: E402
@@ -52,37 +61,117 @@ def check_dataset_outputs(root: str | Path, scene_ids: list[str] | None, glob: s
     for s in scene_ids or []:
         if s in ("", ".", "..") or "/" in s or "\\" in s:
             raise InputError(root_p / s, "a scene id must be the name of a sub-folder of the dataset folder")
+    scenes = find_scenes(root_p, scene_ids, glob)
+    if storage.is_remote(out_root):  # s3://...: each scene's prefix holds nothing react3d did not write
+        for scene in scenes:
+            storage.check_remote_output(f"{str(out_root).rstrip('/')}/{scene.name}")
+        return scenes
     out = Path(out_root)
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise InputError(out, "exists and is not a folder; choose a new --out folder")
-    scenes = find_scenes(root_p, scene_ids, glob)
     for scene in scenes:
         check_output_dir(out / scene.name, (scene, root_p), kind=OUTPUT_KIND)
     return scenes
 
 
-def _one(scene: Path, out_root: Path, config: dict[str, Any] | None) -> dict[str, Any]:
+def scene_out(out_root: str | Path, scene: str) -> str:
+    """Output location of one scene: a folder under a local ``out_root``, a key prefix under a URL."""
+    return f"{str(out_root).rstrip('/')}/{scene}" if storage.is_remote(out_root) else str(Path(out_root) / scene)
+
+
+def count_parts(manifest: str) -> int:
+    """Articulated objects in a published manifest (a local path or a URL)."""
+    return len(json.loads(storage.read_text(manifest)).get("objects", []))
+
+
+def _reason(exc_or_msg: Exception | str) -> str:
+    if isinstance(exc_or_msg, Exception):
+        msg = str(exc_or_msg).strip().splitlines()[0] if str(exc_or_msg).strip() else ""
+        return f"{type(exc_or_msg).__name__}: {msg}"[:300] if msg else type(exc_or_msg).__name__
+    return (exc_or_msg.strip().splitlines() or [""])[0][:300]
+
+
+TABLE_COLUMNS = ("scene", "status", "parts", "seconds", "retries", "worker", "error")
+"""Columns of the ``dataset-summary`` table artifact (and of the CLI's table)."""
+
+
+def _row(scene: str, status: str, t0: float, *, parts: int = 0, manifest: str = "", error: str = "",
+         retries: int = 0, worker: str = "", flow_run: str = "") -> dict[str, Any]:
+    return {"scene": scene, "status": status, "parts": parts, "seconds": round(time.perf_counter() - t0, 1),
+            "retries": retries, "worker": worker, "error": error, "manifest": manifest, "flow_run": flow_run}
+
+
+def _one(scene: Path, out_root: str, config: dict[str, Any] | None) -> dict[str, Any]:
     t0 = time.perf_counter()
     try:
-        manifest = convert_scene.with_options(name=f"convert-{scene.name}")(str(scene), str(out_root / scene.name), config)
-        from react3d_core.data.parts import InteractiveScene
-
-        n = len(InteractiveScene.load(manifest).objects)
-        return {"scene": scene.name, "status": "ok", "parts": n, "seconds": round(time.perf_counter() - t0, 1),
-                "manifest": manifest, "error": ""}
+        manifest = convert_scene.with_options(name=f"convert-{scene.name}")(str(scene), scene_out(out_root, scene.name), config)
+        return _row(scene.name, "ok", t0, parts=count_parts(manifest), manifest=manifest, worker="in-process")
     except Exception as exc:  # noqa: BLE001 - a failed scene is reported, the others go on
-        msg = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        return {"scene": scene.name, "status": "failed", "parts": 0, "seconds": round(time.perf_counter() - t0, 1),
-                "manifest": "", "error": f"{type(exc).__name__}: {msg}"[:300]}
+        return _row(scene.name, "failed", t0, error=_reason(exc), worker="in-process")
+
+
+def fan_out(scenes: list[Path], out_root: str, config: dict[str, Any] | None, deployment: str,
+            max_in_flight: int, max_attempts: int, poll_seconds: float = 2.0) -> list[dict[str, Any]]:
+    """One flow run of ``deployment`` per scene, at most ``max_in_flight`` unfinished at a time; crashed
+    runs are submitted again (up to ``max_attempts`` runs per scene). Rows in the order of ``scenes``.
+
+    Paths sent to workers are absolute (a worker's working directory is not ours); outputs go to
+    ``out_root/<scene>``, a folder every worker reaches or an fsspec URL."""
+    from prefect.client.orchestration import get_client
+    from prefect.deployments import run_deployment
+
+    root_of = {s.name: str(s.resolve()) for s in scenes}
+    out_abs = out_root if storage.is_remote(out_root) else str(Path(out_root).resolve())
+    queue: deque[tuple[str, int]] = deque((s.name, 1) for s in scenes)
+    started = {s.name: time.perf_counter() for s in scenes}
+    running: dict[Any, tuple[str, int]] = {}
+    rows: dict[str, dict[str, Any]] = {}
+    with get_client(sync_client=True) as client:
+        while queue or running:
+            while queue and len(running) < max(1, max_in_flight):
+                name, attempt = queue.popleft()
+                fr = run_deployment(deployment, timeout=0, flow_run_name=f"{name}-attempt{attempt}",
+                                    parameters={"scene_path": root_of[name], "out_dir": scene_out(out_abs, name),
+                                                "config": config or {}},
+                                    tags=["react3d", f"scene:{name}", f"attempt:{attempt}"])
+                running[fr.id] = (name, attempt)
+            time.sleep(poll_seconds)
+            for fid, (name, attempt) in list(running.items()):
+                fr = client.read_flow_run(fid)
+                state = fr.state
+                if state is None or not state.is_final():
+                    continue
+                del running[fid]
+                worker = str((fr.labels or {}).get("prefect.worker.name", ""))
+                common = {"retries": attempt - 1, "worker": worker, "flow_run": str(fid)}
+                if state.is_completed():
+                    manifest = f"{scene_out(out_abs, name)}/scene.json"
+                    try:
+                        rows[name] = _row(name, "ok", started[name], parts=count_parts(manifest), manifest=manifest, **common)
+                    except (OSError, ValueError) as exc:
+                        rows[name] = _row(name, "failed", started[name], error=f"completed but its manifest is unreadable: {_reason(exc)}", **common)
+                elif state.is_crashed() and attempt < max_attempts:
+                    queue.append((name, attempt + 1))  # its finished tasks are cached: the next run resumes
+                else:
+                    why = "crashed" if state.is_crashed() else state.type.value.lower()
+                    rows[name] = _row(name, "failed", started[name], error=f"{why}: {_reason(state.message or state.name or '')}", **common)
+    return [rows[s.name] for s in scenes]
 
 
 @flow(name="react3d-convert-dataset", persist_result=False)
 def convert_dataset(root: str, scene_ids: list[str] | None = None, glob: str | None = None,
                     out_root: str = "react3d_out", config: dict[str, Any] | None = None,
-                    scene_concurrency: int = 1) -> list[dict[str, Any]]:
-    """Convert every selected scene under ``root`` into ``out_root/<scene>``; returns one row per scene."""
+                    scene_concurrency: int = 1, deployment: str | None = None,
+                    max_attempts: int = 3) -> list[dict[str, Any]]:
+    """Convert every selected scene under ``root`` into ``out_root/<scene>``; returns one row per scene.
+
+    ``deployment`` (e.g. ``react3d-convert-scene/convert-scene``) fans scenes out to the workers of its
+    pool; without it scenes run in this process."""
     scenes = check_dataset_outputs(root, scene_ids, glob, out_root)
-    out = Path(out_root)
+    if deployment:
+        rows = fan_out(scenes, out_root, config, deployment, scene_concurrency, max_attempts)
+        _table(rows)
+        return rows
     rows: list[dict[str, Any]] = []
     progress = None
     try:
@@ -92,18 +181,23 @@ def convert_dataset(root: str, scene_ids: list[str] | None = None, glob: str | N
     except Exception:  # noqa: BLE001
         pass
     with ThreadPoolExecutor(max_workers=max(1, scene_concurrency)) as pool:
-        for row in pool.map(lambda s: _one(s, out, config), scenes):
+        for row in pool.map(lambda s: _one(s, out_root, config), scenes):
             rows.append(row)
             if progress is not None:
                 try:
                     update_progress_artifact(progress, 100.0 * len(rows) / max(len(scenes), 1))
                 except Exception:  # noqa: BLE001
                     pass
+    _table(rows)
+    return rows
+
+
+def _table(rows: list[dict[str, Any]]) -> None:
+    """The ``dataset-summary`` table artifact: one row per scene (a no-op outside a Prefect run)."""
     try:
         from prefect.artifacts import create_table_artifact
 
-        create_table_artifact([{k: r[k] for k in ("scene", "status", "parts", "seconds", "error")} for r in rows],
-                              key="dataset-summary", description=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
-    except Exception:  # noqa: BLE001
+        create_table_artifact([{k: r[k] for k in TABLE_COLUMNS} for r in rows], key="dataset-summary",
+                              description=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
+    except Exception:  # noqa: BLE001 - the table is for the UI; the rows are returned either way
         pass
-    return rows

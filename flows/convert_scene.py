@@ -27,6 +27,7 @@ from tasks.assembly import OUTPUT_KIND, assemble, export, output_marker, stage_o
 from tasks.keys import stage_version  # noqa: E402
 from tasks.perception import perceive_frames  # noqa: E402
 from tasks.report import evaluate, finalize, report  # noqa: E402
+from tasks import storage  # noqa: E402
 from tasks.scene import fingerprint_scene  # noqa: E402
 from tasks.segmentation import segment_scene  # noqa: E402
 
@@ -74,8 +75,13 @@ def _chunks(items: list[str], n: int) -> list[list[str]]:
 
 @flow(name="react3d-convert-scene", task_runner=ThreadPoolTaskRunner(max_workers=4), persist_result=False)
 def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None = None) -> str:
-    """Convert the scan at ``scene_path`` into ``out_dir``; returns the manifest path (``scene.json``)."""
+    """Convert the scan at ``scene_path`` into ``out_dir`` (a folder, or an fsspec URL such as
+    ``s3://bucket/out/scene``); returns the manifest path or URL (``scene.json``)."""
     t_all = time.perf_counter()
+    remote_out = out_dir if storage.is_remote(out_dir) else None
+    if remote_out:  # s3://... : built in a local folder, uploaded once complete (tasks/storage.py)
+        storage.check_remote_output(remote_out)
+        out_dir = str(storage.staging_dir(remote_out))
     out = check_output_dir(out_dir, (scene_path,), kind=OUTPUT_KIND)  # before any stage runs
     cfg = PipelineConfig().with_overrides(config or {})
     c = cfg.model_dump(mode="json")
@@ -126,6 +132,8 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
         finalize(staged, c, versions, timings)
         check_output_dir(out, (scene_path,), kind=OUTPUT_KIND)  # nothing of the user's appeared there meanwhile
     manifest, html = str(out / "scene.json"), str(out / "report.html")
+    if remote_out:
+        manifest = storage.publish_tree(out, remote_out)
     publish_scene_artifacts(fp["scene_id"], manifest, html, timings, metrics,
                             n_candidates=seg["n"], n_rejected=sum(p.get("kind") == "rejected" for p in parts))
     return manifest

@@ -71,10 +71,10 @@ def local_path(url: str | os.PathLike[str]) -> Path:
 def cache_root() -> Path:
     """The local root of the store on this worker (the shared folder itself, or the remote's mirror)."""
     st = settings()
-    if st.cache:
-        return Path(st.cache)
     if st.store and not is_remote(st.store):
         return local_path(st.store)
+    if st.cache:
+        return Path(st.cache)
     return Path.home() / ".cache" / "react3d"
 
 
@@ -177,18 +177,24 @@ def pull_dir(rel: str, local: Path, seal_suffix: str) -> bool:
 
 # --- Prefect result storage at the same place --------------------------------------------------------
 
-def configure_result_storage() -> None:
-    """Point Prefect's result records at the store (set before Prefect reads its settings; user values win).
+def result_storage_env(store: str | None) -> dict[str, str]:
+    """Prefect settings that keep result records beside the store ``store``.
 
-    A local/shared store keeps records in ``<store>/prefect-results``; a remote one in the
-    ``remote-file-system/react3d-results`` block (created by :func:`ensure_result_block`)."""
-    st = settings()
-    if not st.store:
-        return
-    if is_remote(st.store):
-        os.environ.setdefault("PREFECT_RESULTS_DEFAULT_STORAGE_BLOCK", f"remote-file-system/{RESULT_BLOCK}")
-    else:
-        os.environ.setdefault("PREFECT_LOCAL_STORAGE_PATH", str(local_path(st.store) / RESULTS_DIR))
+    A local/shared store keeps them in ``<store>/prefect-results``; a remote one in the
+    ``remote-file-system/react3d-results`` block (created by :func:`ensure_result_block`). Prefect reads
+    its settings when it is imported: a worker must have these in its environment (or the deployment's
+    job variables), which ``deployments/local_cluster.py`` and docs/orchestration.md do."""
+    if not store:
+        return {}
+    if is_remote(store):
+        return {"PREFECT_RESULTS_DEFAULT_STORAGE_BLOCK": f"remote-file-system/{RESULT_BLOCK}"}
+    return {"PREFECT_LOCAL_STORAGE_PATH": str(local_path(store) / RESULTS_DIR)}
+
+
+def configure_result_storage() -> None:
+    """Apply :func:`result_storage_env` for ``REACT3D_STORE`` (before ``import prefect``; user values win)."""
+    for k, v in result_storage_env(settings().store).items():
+        os.environ.setdefault(k, v)
 
 
 def ensure_result_block() -> str | None:

@@ -14,7 +14,12 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="Output root: one folder per scene.")
     p.add_argument("--scenes", nargs="*", default=None, help="Scene ids (sub-folder names).")
     p.add_argument("--glob", default=None, help="Pattern on sub-folder names, e.g. '0a*'.")
-    p.add_argument("--concurrency", type=int, default=1, help="Scenes converted at the same time.")
+    p.add_argument("--concurrency", type=int, default=1, help="Scenes converted at the same time (with --deployment: flow runs in flight).")
+    p.add_argument("--deployment", default=None,
+                   help="Fan scenes out to the workers of a deployment, e.g. react3d-convert-scene/convert-scene "
+                        "(needs PREFECT_API_URL of a server; docs/orchestration.md). Default: in this process.")
+    p.add_argument("--max-attempts", type=int, default=3,
+                   help="With --deployment: runs per scene when a run crashes (worker died); failed scenes are not retried.")
     add_pipeline_arguments(p)
 
 
@@ -35,19 +40,26 @@ def run(args: argparse.Namespace) -> int:
 
     cfg = pipeline_overrides(args)
     check_dataset_outputs(args.root, args.scenes, args.glob, args.out)  # before any scene runs
+    from tasks import storage
+
+    storage.ensure_result_block()  # REACT3D_STORE=s3://...: result records beside the store (no-op otherwise)
     console = Console()
     from ._runconfig import log_path, prefect_errors_to_log
 
     # a failed scene is one row of the table below; Prefect's tracebacks for it go to the log file
     with console.status("converting scenes (per-scene progress in the Prefect UI when a server is configured)"), \
             prefect_errors_to_log(log_path()):
-        rows = convert_dataset(args.root, args.scenes, args.glob, args.out, cfg, args.concurrency)
+        rows = convert_dataset(args.root, args.scenes, args.glob, args.out, cfg, args.concurrency,
+                               args.deployment, args.max_attempts)
     t = Table(title=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
-    for c in ("scene", "status", "parts", "seconds", "error"):
+    cols = ("scene", "status", "parts", "seconds", "retries", "worker", "error") if args.deployment else \
+        ("scene", "status", "parts", "seconds", "error")
+    for c in cols:
         t.add_column(c)
     for r in rows:
-        t.add_row(r["scene"], "[green]ok[/green]" if r["status"] == "ok" else "[red]failed[/red]", str(r["parts"]),
-                  f"{r['seconds']:.1f}", r["error"])
+        cells = {**{k: str(r.get(k, "")) for k in cols}, "seconds": f"{r['seconds']:.1f}",
+                 "status": "[green]ok[/green]" if r["status"] == "ok" else "[red]failed[/red]"}
+        t.add_row(*(cells[c] for c in cols))
     console.print(t)
     if Path(log_path()).is_file():
         console.print(f"details of the failures: {log_path()}")
