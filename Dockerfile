@@ -1,7 +1,7 @@
 # REACT3D worker image: our code + CPU torch by default. Build the GPU flavour with
 #   docker build --build-arg EXTRAS=models,sim --build-arg TORCH_INDEX=https://download.pytorch.org/whl/cu124 .
 FROM python:3.11-slim
-ARG EXTRAS=sim
+ARG EXTRAS=sim,s3
 ARG TORCH_INDEX=https://download.pytorch.org/whl/cpu
 RUN apt-get update && apt-get install -y --no-install-recommends libusb-1.0-0 libgomp1 libgl1 libglib2.0-0 git \
     && rm -rf /var/lib/apt/lists/*

@@ -34,12 +34,15 @@ def test_prefect_yaml_entrypoints_exist() -> None:
 def test_compose_services_and_shared_paths() -> None:
     spec = yaml.safe_load((ROOT / "docker-compose.yml").read_text())
     s = spec["services"]
-    assert {"postgres", "prefect-server", "worker-cpu", "worker-gpu"} <= set(s)
+    assert {"postgres", "prefect-server", "object-store", "worker-cpu", "worker-gpu"} <= set(s)
     assert "4200:4200" in s["prefect-server"]["ports"]
-    # every worker sees data and cache at the same absolute path
+    # every worker reaches the same store (S3) and result block; inputs at the same path; own mirror
     for w in ("worker-cpu", "worker-gpu"):
-        assert any(v.endswith(":/data") for v in s[w]["volumes"])
-        assert s[w]["environment"]["REACT3D_CACHE"].startswith("/data/")
+        env = s[w]["environment"]
+        assert any(":/data" in v for v in s[w]["volumes"])
+        assert env["REACT3D_STORE"].startswith("s3://") and env["AWS_ENDPOINT_URL"] == "http://object-store:8333"
+        assert env["PREFECT_RESULTS_DEFAULT_STORAGE_BLOCK"] == "remote-file-system/react3d-results"
+        assert "object-store" in s[w]["depends_on"]
     assert s["worker-gpu"]["deploy"]["resources"]["reservations"]["devices"][0]["capabilities"] == ["gpu"]
 
 
