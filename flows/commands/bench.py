@@ -40,6 +40,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="Frame stride (default 1: synthetic captures are already sparse; use 5 for raw ScanNet++ iPhone).")
     p.add_argument("--cold", action="store_true",
                    help="Convert every scene with an empty cache (first-run timings; nothing reused from earlier runs).")
+    p.add_argument("--no-miss-causes", dest="miss_causes", action="store_false",
+                   help="Skip the miss-cause breakdown (it re-runs perception and segmentation traced, after the timed conversion).")
 
 
 def load_spec(spec: str, out_dir: Path, frames: int | None = None) -> list[dict[str, Any]]:
@@ -96,10 +98,13 @@ def cold_cache(root: str | Path) -> Iterator[Path]:
         shutil.rmtree(root, ignore_errors=True)
 
 
-def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold: str | None = None) -> dict[str, Any]:
+def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold: str | None = None,
+            miss_causes: bool = False) -> dict[str, Any]:
     """Child-process body: generate if missing, convert (timed), return timings and peak RSS.
 
     ``cold``: a scratch folder; the conversion then starts from an empty cache (see :func:`cold_cache`).
+    ``miss_causes``: also attribute each missed / mis-jointed GT part to a stage (flows.miss_causes), after
+    the timings and peak memory are taken.
     """
     scene_dir = Path(entry["scene_dir"])
     if "source" in entry and not (scene_dir / "scans").is_dir():
@@ -114,7 +119,15 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
         t0 = time.perf_counter()
         manifest = convert_scene(str(scene_dir), result_dir, config)
         wall = time.perf_counter() - t0
-    return {"manifest": str(manifest), "wall_s": wall, "peak_rss_mb": _peak_rss_mb(), "rss_before_mb": rss0}
+        out = {"manifest": str(manifest), "wall_s": wall, "peak_rss_mb": _peak_rss_mb(), "rss_before_mb": rss0}
+        if miss_causes:
+            try:
+                from flows.miss_causes import trace_scene
+
+                out["miss_causes"] = trace_scene(str(scene_dir), str(manifest), config)
+            except Exception as exc:  # noqa: BLE001 - a failed breakdown must not fail the scene's scores
+                out["miss_causes"] = {"error": f"{exc.__class__.__name__}: {exc}"}
+    return out
 
 
 def _stopping_server(fn: Callable[..., Any], *args: Any) -> Any:
@@ -143,22 +156,26 @@ def _gt_dir(scene_dir: Path) -> Path | None:
     return None
 
 
-def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, Any], cold: bool = False) -> dict[str, Any]:
+def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, Any], cold: bool = False,
+              miss_causes: bool = False) -> dict[str, Any]:
     """Convert and evaluate every entry; failed scenes are reported in ``failed`` and skipped.
 
-    ``cold``: each scene converts with an empty cache (under ``out_dir/cold-cache``, removed after)."""
+    ``cold``: each scene converts with an empty cache (under ``out_dir/cold-cache``, removed after).
+    ``miss_causes``: each scene gets ``miss_causes`` (counts per cause and one row per traced GT part)
+    and the result a pooled ``miss_causes`` (every cause key present; docs/evaluation.md)."""
     from react3d_core.config.evaluation import EvaluationConfig
     from react3d_core.data.parts import InteractiveScene
     from react3d_core.ground_truth.articulate3d import read_articulate3d
     from react3d_core.metrics import evaluate_scene, to_json_dict
+    from react3d_core.metrics.miss_causes import pool_counts
 
-    scenes, failed = [], []
+    scenes, failed, causes = [], [], []
     for e in entries:
         res_dir = out_dir / "results" / e["name"]
         try:
             if "source" not in e and not Path(e["scene_dir"]).is_dir():
                 raise InputError(e["scene_dir"], "scene folder not found")
-            r = run_isolated(run_one, e, str(res_dir), config, str(out_dir / "cold-cache") if cold else None)
+            r = run_isolated(run_one, e, str(res_dir), config, str(out_dir / "cold-cache") if cold else None, miss_causes)
             pred = InteractiveScene.load(r["manifest"])
             gt_dir = _gt_dir(Path(e["scene_dir"]))
             if gt_dir is None:
@@ -168,9 +185,14 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
             sm.wall_s, sm.peak_rss_mb = r["wall_s"], r["peak_rss_mb"]
             sm.frames = e.get("n_frames")
             scenes.append(sm)
+            causes.append(r.get("miss_causes"))
         except Exception as exc:  # noqa: BLE001 - one failed scene must not stop the benchmark
             failed.append({"scene": e["name"], "error": f"{exc.__class__.__name__}: {exc}"})
     result = to_json_dict(scenes)
+    if miss_causes:
+        for row, mc in zip(result["scenes"], causes):
+            row["miss_causes"] = mc
+        result["miss_causes"] = pool_counts([mc for mc in causes if mc and "counts" in mc])
     result["failed"] = failed
     result["config"] = config
     return result
@@ -194,6 +216,11 @@ def print_table(result: dict[str, Any]) -> None:
                   f(s.get("peak_rss_mb")), f(a.get("f1")), f(b.get("f1")), f(a.get("joint_acc"), True), f(a.get("md")),
                   f(a.get("oe")), f(a.get("mod"), True))
     Console().print(t)
+    mc = result.get("miss_causes")
+    if mc:
+        for kind, title in (("miss", "missed or IoU < 0.5"), ("joint", "joint errors")):
+            top = sorted(((n, k) for k, n in mc[kind].items() if n), reverse=True)
+            Console().print(f"causes, {title}: " + (", ".join(f"{k} {n}" for n, k in top) if top else "none"))
     for fl in result.get("failed", []):
         Console().print(f"[red]failed[/red] {fl['scene']}: {fl['error']}")
 
@@ -208,7 +235,7 @@ def run(args: argparse.Namespace) -> int:
         config["export"] = {"formats": [f.strip() for f in args.formats.split(",") if f.strip() and f.strip() != "none"]}
     if args.no_refine:
         config["articulation"] = {"refine": False}
-    result = run_bench(entries, out_dir, config, cold=args.cold)
+    result = run_bench(entries, out_dir, config, cold=args.cold, miss_causes=args.miss_causes)
     print_table(result)
     write_json(args.json_path or out_dir / "bench.json", result)
     return 0 if not result["failed"] else 1

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -23,6 +24,29 @@ from .topk import top_views_from_stats
 
 DUPLICATE_IOU = 0.5
 CONTAINED = 0.8
+
+
+@dataclass
+class ProposalOutcome:
+    """What became of one fused proposal: ``status`` is ``candidate`` or why it made none
+    (``no_views``, ``claimed`` by an earlier candidate, ``reseg_empty``, ``clip_empty``)."""
+
+    status: str
+    reseg_faces: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    kept_faces: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+
+
+@dataclass
+class SegmentationTrace:
+    """Intermediate results of one ``segment_parts`` run, kept only when asked for (miss-cause
+    attribution, react3d_core.metrics.miss_causes): lifted masks, view statistics, Louvain proposals,
+    each proposal's outcome and the candidates before the duplicate drop."""
+
+    lifts: list[FrameLift] = field(default_factory=list)
+    stats: list[ViewStats] = field(default_factory=list)
+    proposals: list[Proposal] = field(default_factory=list)
+    outcomes: list[ProposalOutcome] = field(default_factory=list)
+    before_duplicates: list[PartCandidate] = field(default_factory=list)
 
 
 def render_work(rasterizer: Rasterizer, frame: Frame, config: PipelineConfig) -> RasterResult:
@@ -86,8 +110,10 @@ def candidates_from_proposals(
     rasterizer: Rasterizer,
     config: PipelineConfig,
     wfaces: np.ndarray,
+    trace: SegmentationTrace | None = None,
 ) -> list[PartCandidate]:
-    """Top-k views, re-segmentation in the best view and clipping for each proposal."""
+    """Top-k views, re-segmentation in the best view and clipping for each proposal (``trace``: records
+    each proposal's outcome)."""
     from .reseg import resegment
 
     tops = top_views_from_stats([p.face_ids for p in proposals], stats, masks, mesh.n_faces, config)
@@ -97,17 +123,24 @@ def candidates_from_proposals(
     claimed = np.zeros(mesh.n_faces, bool)
     # best-seen proposals first; one mostly inside an earlier candidate would re-segment to it
     order = sorted(range(len(proposals)), key=lambda i: (-(tops[i][0].iou if tops[i] else 0.0), -len(proposals[i].face_ids)))
+    outcomes = [ProposalOutcome("no_views") for _ in proposals]
     for i in order:
         prop, tv = proposals[i], tops[i]
-        if not tv or claimed[prop.face_ids].mean() > CONTAINED:
+        if not tv:
+            continue
+        if claimed[prop.face_ids].mean() > CONTAINED:
+            outcomes[i] = ProposalOutcome("claimed")
             continue
         frame = by_id[tv[0].frame_id]
         faces, _mask = resegment(frame, mesh, wfaces, centroids, prop.face_ids, tv, buffers, point_segmenter, rasterizer, config)
         if not len(faces):
+            outcomes[i] = ProposalOutcome("reseg_empty")
             continue
         kept, n, d = clip_part(mesh, faces, frame.c2w[:3, 3], config.clip)
         if n is not None and len(kept):
             kept = largest_component(mesh, wfaces, kept, config.fusion.attach_m)
+        outcomes[i] = ProposalOutcome("candidate" if len(kept) else "clip_empty", np.asarray(faces, np.int64),
+                                      np.asarray(kept, np.int64))
         if not len(kept):
             continue
         claimed[kept] = True
@@ -124,6 +157,9 @@ def candidates_from_proposals(
                 proposal_face_ids=prop.face_ids,
             )
         )
+    if trace is not None:
+        trace.outcomes = outcomes
+        trace.before_duplicates = list(out)
     return drop_duplicates(out, mesh)
 
 
@@ -136,11 +172,12 @@ def segment_parts(
     rasterizer: Rasterizer | None = None,
     timings: dict[str, float] | None = None,
     fusion_mesh: FusionMesh | None = None,
+    trace: SegmentationTrace | None = None,
 ) -> list[PartCandidate]:
     """Masks per frame -> movable-part candidates on the full-resolution scan, with their top-k views.
 
     ``timings`` (optional) receives seconds per sub-stage; ``fusion_mesh`` reuses a prepared
-    (decimated, welded) mesh across calls.
+    (decimated, welded) mesh across calls; ``trace`` (optional) receives the intermediate results.
     """
     t = timings if timings is not None else {}
     t0 = time.perf_counter()
@@ -155,7 +192,10 @@ def segment_parts(
 
     wfaces = fm.wfaces if fm.mesh is mesh else welded_faces(mesh, config.fusion.weld_m)
     t4 = time.perf_counter()
-    cands = candidates_from_proposals(scene, mesh, proposals, buffers, stats, masks, point_segmenter, rasterizer, config, wfaces)
+    if trace is not None:
+        trace.lifts, trace.stats, trace.proposals = lifts, stats, list(proposals)
+    cands = candidates_from_proposals(scene, mesh, proposals, buffers, stats, masks, point_segmenter, rasterizer, config,
+                                      wfaces, trace)
     t5 = time.perf_counter()
     t.update(prepare=t1 - t0, weld_full=t4 - t3, lift=t2 - t1, fuse=t3 - t2, topk_reseg_clip=t5 - t4,
              n_proposals=float(len(proposals)), n_candidates=float(len(cands)))
