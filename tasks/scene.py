@@ -25,7 +25,9 @@ from .store import tree_fingerprint
 
 @lru_cache(maxsize=4)
 def _scene(scene_path: str, frames_json: str) -> SceneInput:
-    return load_scene(scene_path, FrameSelectionConfig.model_validate(json.loads(frames_json)))
+    # the worker's cached rasterizer serves keyframe coverage and every later stage
+    return load_scene(scene_path, FrameSelectionConfig.model_validate(json.loads(frames_json)),
+                      rasterizer=lambda mesh_path: rasterizer(str(mesh_path)))
 
 
 def scene_input(scene_path: str, frames_cfg: dict[str, Any]) -> SceneInput:
@@ -52,6 +54,7 @@ def fingerprint_body(scene_path: str, frames_cfg: dict[str, Any]) -> dict[str, A
         "sha256": sha,
         "scene_id": scene.scene_id,
         "frame_ids": [f.frame_id for f in scene.frames],
+        "frame_selection": scene.frame_selection,
         "mesh_path": str(scene.mesh_path),
         "has_gt": scene.gt_dir is not None,
         "gt_dir": str(scene.gt_dir) if scene.gt_dir is not None else None,

@@ -17,8 +17,9 @@ def add_pipeline_arguments(p: argparse.ArgumentParser) -> None:
                    help="Perception backend (default: heuristic, weight-free).")
     p.add_argument("--config", default=None, help="Pipeline config: a JSON file or an inline JSON object (partial).")
     p.add_argument("--no-refine", action="store_true", help="Keep the predictor's joints (refinement ablation).")
-    p.add_argument("--stride", type=int, default=None, help="Use every n-th frame (default from config: 5).")
-    p.add_argument("--max-frames", type=int, default=None, help="Cap on frames used.")
+    p.add_argument("--stride", type=int, default=None,
+                   help="Use every n-th frame (default: keyframes by camera motion and new surface, cap 300).")
+    p.add_argument("--max-frames", type=int, default=None, help="Cap on frames used (evenly subsampled).")
     p.add_argument("--formats", default=None, help="Export formats, e.g. urdf,usd,mjcf ('none': no simulator files).")
 
 
@@ -64,9 +65,10 @@ def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
     return cfg
 
 
-def precheck_scene(scene: str, cfg: dict[str, Any]) -> None:
+def precheck_scene(scene: str, cfg: dict[str, Any]) -> str:
     """Load and validate the scan (frames, depth sizes, JPEGs, units) before Prefect starts, so bad input
-    gives one line and no Prefect logs; the flow then reuses what was loaded (per-process caches)."""
+    gives one line and no Prefect logs; the flow then reuses what was loaded (per-process caches).
+    Returns how the frames were selected ("kept N of M frames: ...")."""
     from tasks import prefect_env
 
     prefect_env.configure()
@@ -77,6 +79,7 @@ def precheck_scene(scene: str, cfg: dict[str, Any]) -> None:
     frames_cfg = PipelineConfig().with_overrides(cfg).model_dump(mode="json")["frames"]
     loaded = scene_input(scene, frames_cfg)
     check_scale(loaded, scan_mesh(str(loaded.mesh_path)))
+    return loaded.frame_selection
 
 
 def _check_formats(formats: object) -> None:

@@ -25,7 +25,8 @@ def run(args: argparse.Namespace) -> int:
 
     cfg = pipeline_overrides(args)
     check_output_dir(args.out, (args.scene,), kind="scene")  # before Prefect starts: one line, nothing touched
-    precheck_scene(args.scene, cfg)
+    console = Console()
+    console.print(precheck_scene(args.scene, cfg), markup=False, highlight=False)  # "kept N of M frames: why"
     manifest = run_with_progress(args.scene, args.out, cfg, f"converting {args.scene}")
-    print_summary(Console(), manifest)
+    print_summary(console, manifest)
     return 0

@@ -135,6 +135,7 @@ class SceneInput(BaseModel):
     source_format: str = Field(description="'scannetpp_iphone', 'scannetpp_dslr', 'prepared', 'generic', 'synthetic'.")
     gt_dir: Path | None = Field(None, description="Folder with Articulate3D <scan>_parts.json / _artic.json.")
     notes: tuple[str, ...] = Field((), description="Non-fatal problems found while loading.")
+    frame_selection: str = Field("", description="How the frames were chosen: kept N of M and by which rule.")
 
     def frame(self, frame_id: str) -> Frame:
         for f in self.frames:

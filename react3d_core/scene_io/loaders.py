@@ -9,6 +9,7 @@ and the ScanNet++ DSLR layout (dslr.py: fisheye undistortion + mesh-rendered dep
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 from pathlib import Path
 
 import cv2
@@ -20,7 +21,7 @@ from ..data.frames import Frame, ImageRef, Intrinsics, SceneInput, validate_pose
 from ..errors import InputError
 from .depth_bin import DepthBin
 from .images import check_jpeg_complete, depth_size_problem
-from .selection import select_frames
+from .selection import FrameSelection, choose_frames
 
 SCANNETPP_K_SIZE = (1920, 1440)
 DEPTH_SIZE = (256, 192)
@@ -263,24 +264,35 @@ def _load_generic(root: Path, scannetpp_world: bool | None = None) -> SceneInput
 
 def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, *,
                layout: str | None = None, scannetpp_world: bool | None = None,
-               cache_dir: str | Path | None = None) -> SceneInput:
+               cache_dir: str | Path | None = None, rasterizer: Callable[[Path], object] | None = None) -> SceneInput:
     """Load any supported layout (auto-detected unless ``layout`` is given), then select frames.
 
-    ``cache_dir`` (DSLR only; default ``<scene>/.react3d_cache``) receives undistorted images and rendered depth."""
+    ``cache_dir`` (DSLR only; default ``<scene>/.react3d_cache``) receives undistorted images and rendered depth.
+    ``rasterizer(mesh_path)`` gives the scan's :class:`~react3d_core.raster.Rasterizer` for the coverage rule
+    of keyframe selection (default: built from the mesh here; callers that keep one pass theirs)."""
     root = Path(path)
     if not root.is_dir():
         raise InputError(root, "scene folder not found")
     layout = layout or detect_layout(root)
+    chosen: list[FrameSelection] = []
+
+    def sel(frames: list[Frame], mesh: Path) -> list[Frame]:
+        r = None
+        if selection is not None and selection.stride is None and selection.coverage_width > 0:
+            r = rasterizer(mesh) if rasterizer is not None else _default_rasterizer(mesh)
+        chosen.append(choose_frames(frames, selection, r))  # type: ignore[arg-type]
+        return chosen[-1].frames
+
     if layout == "scannetpp_dslr":
         from .dslr import load_dslr_frames
 
         mesh = _check_mesh(root / "scans" / "mesh_aligned_0.05.ply")
         cache = Path(cache_dir) if cache_dir else root / ".react3d_cache"
-        sel = (lambda fs: select_frames(fs, selection)) if selection is not None else list
-        frames = load_dslr_frames(root, cache / "dslr", mesh, sel)
+        frames = load_dslr_frames(root, cache / "dslr", mesh, (lambda fs: sel(fs, mesh)) if selection is not None else list)
         gt_dir = next((d for d in (root / "articulate3d", root.parent / "articulate3d") if d.is_dir()), None)
         return SceneInput(scene_id=root.name, root=root, mesh_path=mesh, frames=tuple(frames),
-                          source_format="scannetpp_dslr", gt_dir=gt_dir)
+                          source_format="scannetpp_dslr", gt_dir=gt_dir,
+                          frame_selection=chosen[-1].reason if chosen else "")
     if layout == "scannetpp_iphone":
         scene = _load_iphone(root)
     elif layout == "prepared":
@@ -290,5 +302,13 @@ def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, 
     else:
         raise InputError(root, f"unsupported layout {layout!r}")
     if selection is not None:
-        scene = scene.model_copy(update={"frames": tuple(select_frames(scene.frames, selection))})
+        frames = sel(list(scene.frames), scene.mesh_path)
+        scene = scene.model_copy(update={"frames": tuple(frames), "frame_selection": chosen[-1].reason})
     return scene
+
+
+def _default_rasterizer(mesh_path: Path) -> object:
+    from ..data.mesh import load_mesh
+    from ..raster import Rasterizer
+
+    return Rasterizer(load_mesh(mesh_path))

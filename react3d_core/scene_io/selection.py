@@ -1,11 +1,39 @@
-"""Frame selection: stride, then keyframes by pose change, then an even cap (FrameSelectionConfig)."""
+"""Frame selection (FrameSelectionConfig): keyframes by what the views add (default), or an explicit stride.
+
+Keyframes: a frame is kept when the camera moved or turned enough since the last kept frame (a static
+or slowly drifting camera adds nothing) *and*, when a rasterizer of the scan is given, when enough of
+what it sees is surface not yet covered by ``coverage_target_views`` kept frames (a camera walking the
+same path twice adds nothing the second time). Coverage is counted on the scan points a low-resolution
+face-id/depth buffer hits, binned in voxels, so it does not depend on how finely the mesh is
+triangulated. Both rules are in metres, degrees and surface, not frame counts, so a 60 fps video and a
+sparse capture of the same walk give similar selections. Then an even cap.
+"""
 
 from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
 from ..config.frames import FrameSelectionConfig
 from ..data.frames import Frame
+
+#: voxel edge (m) for counting how often a piece of surface was seen; about one low-res pixel at 2 m
+COVERAGE_VOXEL_M = 0.05
+_HASH_BITS = 22  # 4 M counters (16 MB); collisions only merge far-apart voxels' counts
+
+
+@dataclass(frozen=True)
+class FrameSelection:
+    """The kept frames and a one-line account of why (printed by ``react3d convert``)."""
+
+    frames: list[Frame]
+    total: int
+    reason: str
+    skipped_motion: int = 0
+    skipped_coverage: int = 0
+    dropped_by_cap: int = 0
 
 
 def _rotation_deg(Ra: np.ndarray, Rb: np.ndarray) -> float:
@@ -13,20 +41,91 @@ def _rotation_deg(Ra: np.ndarray, Rb: np.ndarray) -> float:
     return float(np.degrees(np.arccos(np.clip(c, -1.0, 1.0))))
 
 
-def select_frames(frames: list[Frame] | tuple[Frame, ...], cfg: FrameSelectionConfig) -> list[Frame]:
-    """Apply stride, keyframe filter (translation OR rotation above threshold), then max_frames evenly."""
-    out = list(frames)[:: cfg.stride]
-    if cfg.keyframes and out:
+def _even_cap(items: list[Frame], cap: int | None) -> list[Frame]:
+    if cap is None or len(items) <= cap:
+        return items
+    idx = np.unique(np.round(np.linspace(0, len(items) - 1, cap)).astype(int))
+    return [items[i] for i in idx]
+
+
+def _voxel_hashes(rast: object, frame: Frame, width: int) -> np.ndarray:
+    """Hashed voxel ids of the scan points this frame sees, from a ``width``-pixel-wide depth buffer."""
+    intr = frame.intrinsics
+    intr = intr.scaled(width, max(1, round(intr.height * width / intr.width)))
+    res = rast.render(intr.K, frame.c2w, intr.width, intr.height, frame.frame_id)  # type: ignore[attr-defined]
+    v, u = np.nonzero(res.depth > 0)
+    if u.size == 0:
+        return np.zeros(0, np.int64)
+    z = res.depth[v, u].astype(np.float64)
+    cam = np.stack([(u - intr.cx) / intr.fx * z, (v - intr.cy) / intr.fy * z, z], 1)
+    c2w = frame.c2w
+    pts = cam @ c2w[:3, :3].T + c2w[:3, 3]
+    ijk = np.floor(pts / COVERAGE_VOXEL_M).astype(np.int64)
+    h = (ijk[:, 0] * 73856093) ^ (ijk[:, 1] * 19349663) ^ (ijk[:, 2] * 83492791)
+    return np.unique(h & ((1 << _HASH_BITS) - 1))
+
+
+def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: object | None) -> FrameSelection:
+    n = len(frames)
+    poses = np.stack([f.c2w for f in frames])
+    use_cov = rasterizer is not None and cfg.coverage_width > 0
+    counts = np.zeros(1 << _HASH_BITS, np.int32) if use_cov else None
+    kept = [0]
+    if use_cov:
+        counts[_voxel_hashes(rasterizer, frames[0], cfg.coverage_width)] += 1  # type: ignore[index]
+    last = poses[0]
+    skip_motion = skip_cov = 0
+    for i in range(1, n):
+        cur = poses[i]
+        moved = float(np.linalg.norm(cur[:3, 3] - last[:3, 3])) >= cfg.keyframe_translation_m
+        if not moved and _rotation_deg(last[:3, :3], cur[:3, :3]) < cfg.keyframe_rotation_deg:
+            skip_motion += 1
+            continue
+        if use_cov:
+            vox = _voxel_hashes(rasterizer, frames[i], cfg.coverage_width)
+            new = float(np.mean(counts[vox] < cfg.coverage_target_views)) if vox.size else 0.0  # type: ignore[index]
+            if new < cfg.coverage_min_new:
+                skip_cov += 1
+                continue
+            counts[vox] += 1  # type: ignore[index]
+        kept.append(i)
+        last = cur
+    cap = cfg.keyframe_cap if cfg.max_frames is None else min(cfg.keyframe_cap, cfg.max_frames)
+    out = _even_cap([frames[i] for i in kept], cap)
+    rule = (f"motion (>= {cfg.keyframe_translation_m:g} m or >= {cfg.keyframe_rotation_deg:g} deg)"
+            + (f"/coverage (>= {cfg.coverage_min_new:.0%} of the view seen in < {cfg.coverage_target_views} kept frames)"
+               if use_cov else ", no coverage check (no mesh)"))
+    why = [f"{skip_motion} too little motion"] if skip_motion else []
+    why += [f"{skip_cov} no new surface"] if skip_cov else []
+    why += [f"{len(kept) - len(out)} by the cap"] if len(out) < len(kept) else []
+    reason = (f"kept {len(out)} of {n} frames: keyframes by {rule}, cap {cap}"
+              + (f"; skipped {', '.join(why)}" if why else ""))
+    return FrameSelection(out, n, reason, skip_motion, skip_cov, len(kept) - len(out))
+
+
+def choose_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer: object | None = None) -> FrameSelection:
+    """Select frames per ``cfg``; ``rasterizer`` (a :class:`react3d_core.raster.Rasterizer` of the scan)
+    enables the coverage rule of keyframe mode."""
+    frames = list(frames)
+    if not frames:
+        return FrameSelection([], 0, "no frames")
+    if cfg.stride is None:
+        return _keyframes(frames, cfg, rasterizer)
+    out = frames[:: cfg.stride]
+    filt = ""
+    if cfg.keyframes:
         kept = [out[0]]
         for f in out[1:]:
-            last = kept[-1].c2w
-            cur = f.c2w
-            moved = np.linalg.norm(cur[:3, 3] - last[:3, 3]) >= cfg.keyframe_translation_m
-            turned = _rotation_deg(last[:3, :3], cur[:3, :3]) >= cfg.keyframe_rotation_deg
-            if moved or turned:
+            moved = np.linalg.norm(f.c2w[:3, 3] - kept[-1].c2w[:3, 3]) >= cfg.keyframe_translation_m
+            if moved or _rotation_deg(kept[-1].c2w[:3, :3], f.c2w[:3, :3]) >= cfg.keyframe_rotation_deg:
                 kept.append(f)
-        out = kept
-    if cfg.max_frames is not None and len(out) > cfg.max_frames:
-        idx = np.unique(np.round(np.linspace(0, len(out) - 1, cfg.max_frames)).astype(int))
-        out = [out[i] for i in idx]
-    return out
+        out, filt = kept, f", then motion >= {cfg.keyframe_translation_m:g} m or >= {cfg.keyframe_rotation_deg:g} deg"
+    capped = _even_cap(out, cfg.max_frames)
+    reason = (f"kept {len(capped)} of {len(frames)} frames: stride {cfg.stride}{filt}"
+              + (f", cap {cfg.max_frames}" if cfg.max_frames is not None else ""))
+    return FrameSelection(capped, len(frames), reason, dropped_by_cap=len(out) - len(capped))
+
+
+def select_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer: object | None = None) -> list[Frame]:
+    """The frames :func:`choose_frames` keeps."""
+    return choose_frames(frames, cfg, rasterizer).frames
