@@ -20,7 +20,12 @@ COMMANDS: dict[str, str] = {
     "export": "flows.commands.export",
     "view": "flows.commands.view",
     "cache": "flows.commands.cache",
+    "server": "flows.commands.server",
 }
+
+FLOW_COMMANDS = {"convert", "demo", "convert-dataset"}
+"""Commands that run Prefect flows: they reuse the server named by PREFECT_API_URL (checked first, one-line
+error if it does not answer), or start a temporary one and say so (``tasks.prefect_env.check_server``)."""
 
 
 def _load(name: str):  # noqa: ANN202
@@ -56,6 +61,10 @@ def main(argv: list[str] | None = None) -> int:
 
     debug = args.verbose or bool(os.environ.get("REACT3D_DEBUG"))
     try:
+        if args.command in FLOW_COMMANDS:
+            from tasks.prefect_env import check_server
+
+            check_server()
         return int(args._run(args) or 0)
     except React3DError as exc:
         if debug:

@@ -45,6 +45,9 @@ def main(argv: list[str]) -> None:
 def _popen(args: Any, **kwargs: Any) -> subprocess.Popen[Any]:
     """``subprocess.Popen`` as Prefect's server module sees it: ``python -m uvicorn`` goes through main()."""
     if isinstance(args, list) and args[1:3] == ["-m", "uvicorn"]:
+        from tasks.prefect_env import TEMPORARY_NOTE
+
+        print(TEMPORARY_NOTE, file=sys.stderr, flush=True)  # the one line saying where the seconds go
         args = [args[0], "-m", "flows.server_watchdog", str(os.getpid()), *args[3:]]
         env = dict(kwargs.get("env") or os.environ)
         root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))

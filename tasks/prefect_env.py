@@ -37,6 +37,55 @@ def configure() -> None:
     configure_result_storage()  # result records beside the shared store (REACT3D_STORE), issue 21
 
 
+# --- Which server a command talks to ----------------------------------------------------------------
+#
+# Without an API URL every command starts Prefect's temporary server (4-15 s on 2 cores, plus ~2.5 s of
+# importing the server modules) and stops it at exit. A server that is already running (``react3d
+# server`` or ``prefect server start``), named by ``PREFECT_API_URL`` (environment or Prefect profile),
+# is reused: runs, retries and history all land in its UI, and a command pays none of that start-up.
+
+TEMPORARY_NOTE = ("react3d: starting a temporary Prefect server for this command (~5-15 s); to reuse one across "
+                  "commands run `react3d server` and set PREFECT_API_URL=http://127.0.0.1:4200/api")
+
+
+def api_url() -> str | None:
+    """The Prefect API this process will use (environment or active profile); None = temporary server."""
+    configure()
+    from prefect.settings import get_current_settings
+
+    return get_current_settings().api.url or None
+
+
+def server_reachable(url: str, timeout: float = 3.0) -> bool:
+    """Whether a Prefect API answers ``GET <url>/health`` (plain urllib: no client set-up cost)."""
+    import urllib.error
+    import urllib.request
+
+    try:
+        with urllib.request.urlopen(url.rstrip("/") + "/health", timeout=timeout) as resp:  # noqa: S310 (user's own URL)
+            return resp.status == 200
+    except (urllib.error.URLError, OSError, ValueError):
+        return False
+
+
+def check_server() -> str:
+    """Before a command runs flows: ``"running"`` when ``PREFECT_API_URL`` names a server that answers,
+    ``"temporary"`` when none is set (Prefect starts one at the first flow call; the line
+    :data:`TEMPORARY_NOTE` is printed then, by ``flows.server_watchdog``).
+
+    A URL that does not answer is a one-line :class:`~react3d_core.errors.ConfigError` instead of
+    Prefect's retries and traceback minutes later."""
+    url = api_url()
+    if not url:
+        return "temporary"
+    if not server_reachable(url):
+        from react3d_core.errors import ConfigError
+
+        raise ConfigError(f"PREFECT_API_URL={url} does not answer: start it (`react3d server`) or unset "
+                          "PREFECT_API_URL to let this command start a temporary server")
+    return "running"
+
+
 # --- Result records: read only what react3d itself writes -------------------------------------------
 #
 # A Prefect result record names its own serializer, and Prefect 3 decodes the record with whatever it

@@ -41,7 +41,11 @@ def report_body(manifest_path: str, scene_path: str, frames_cfg: dict[str, Any],
     per_tau = None
     if metrics:
         per_tau = metrics.get("aggregate", metrics)
-    return str(write_report(manifest_path, scene_input=scene_input(scene_path, frames_cfg), metrics=per_tau))
+    from .store import cache_root
+
+    # thumbnails and viewer meshes by content: a re-convert of the same scene does not redo them
+    return str(write_report(manifest_path, scene_input=scene_input(scene_path, frames_cfg), metrics=per_tau,
+                            cache_dir=cache_root() / "reports"))
 
 
 @task(name="evaluate-scene", persist_result=False)

@@ -144,23 +144,71 @@ def _timings_table(timings: dict[str, float]) -> str:
     return f"<h2>Timings (s)</h2><table><tr><th>stage</th><th>seconds</th></tr>{rows}</table>"
 
 
+REPORT_CACHE_VERSION = "1"
+"""Bump when the thumbnails or the viewer payload change: part of the report cache key."""
+
+
+def _file_sha(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for block in iter(lambda: fh.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def report_cache_key(scene: InteractiveScene, root: Path, scene_input: SceneInput | None, thumbnails: bool) -> str:
+    """Content key of what the report draws: the objects, every mesh under ``meshes/``, the scan mesh and
+    the frames its thumbnails use (their pose, intrinsics, image path, size and mtime). Timings, config
+    and versions are not in it: they change every run and are re-read from the manifest."""
+    h = hashlib.sha256(f"report|{REPORT_CACHE_VERSION}|{thumbnails}|{scene_input is not None}".encode())
+    h.update(json.dumps([o.model_dump(mode="json") for o in scene.objects], sort_keys=True).encode())
+    h.update(scene.background_mesh.encode())
+    for p in sorted((root / "meshes").rglob("*")):
+        if p.is_file():
+            h.update(p.relative_to(root).as_posix().encode() + _file_sha(p).encode())
+    if thumbnails and scene_input is not None and scene.objects:
+        mesh_path = Path(scene.input_mesh)
+        mesh_path = mesh_path if mesh_path.is_absolute() else root / mesh_path
+        h.update(_file_sha(mesh_path).encode())
+        used = {v["frame_id"] for o in scene.objects for v in o.top_views if "frame_id" in v}
+        used |= {o.seg_frame_id for o in scene.objects if o.seg_frame_id}
+        for f in scene_input.frames:
+            if f.frame_id in used:
+                st = f.rgb.path.stat() if f.rgb.path.is_file() else None
+                h.update(f.model_dump_json().encode() + repr((st.st_size, st.st_mtime_ns) if st else None).encode())
+    return h.hexdigest()
+
+
 def write_report(
     manifest_path: str | Path,
     out_path: str | Path | None = None,
     scene_input: SceneInput | None = None,
     metrics: dict[str, Any] | None = None,
     thumbnails: bool = True,
+    cache_dir: str | Path | None = None,
 ) -> Path:
     """Write ``report.html`` next to the manifest: viewer, parts with thumbnails, metrics, timings.
 
     ``metrics`` is the per-threshold dict (``{"0.25": {...}, "0.5": {...}}``) when GT exists;
-    thumbnails need the scene input (frames) and are skipped without it.
+    thumbnails need the scene input (frames) and are skipped without it. ``cache_dir``: the thumbnails
+    and the decimated viewer meshes (seconds on a 490k-face scan: ray casting and simplification) are
+    kept there by content (:func:`report_cache_key`), so re-converting the same scene reuses them.
     """
     manifest_path = Path(manifest_path)
     if manifest_path.is_dir():
         manifest_path = manifest_path / "scene.json"
     scene = InteractiveScene.load(manifest_path)
     root = manifest_path.parent
+    cached: Path | None = None
+    if cache_dir is not None:
+        key = report_cache_key(scene, root, scene_input, thumbnails)
+        cached = Path(cache_dir) / key[:2] / f"report-{key}.json"
+        if cached.is_file():
+            try:
+                d = json.loads(cached.read_text())
+                return _write_page(scene, root, out_path, metrics, d["thumbs"], d["payload"])
+            except (OSError, ValueError, KeyError):
+                pass  # unreadable: rebuild and overwrite
     thumbs: dict[str, list[str]] = {}
     if thumbnails and scene_input is not None and scene.objects:
         from .thumbnails import part_thumbnails
@@ -175,6 +223,15 @@ def write_report(
             frames = [v["frame_id"] for v in o.top_views if "frame_id" in v] or ([o.seg_frame_id] if o.seg_frame_id else [])
             parts[o.object_id] = (load_vertex_ids(root / o.source_vertex_ids), frames)
         thumbs = part_thumbnails(scene_input, mesh, parts)
+    payload = scene_payload(manifest_path)
+    if cached is not None:
+        write_text(cached, json.dumps({"thumbs": thumbs, "payload": payload}))
+    return _write_page(scene, root, out_path, metrics, thumbs, payload)
+
+
+def _write_page(scene: InteractiveScene, root: Path, out_path: str | Path | None, metrics: dict[str, Any] | None,
+                thumbs: dict[str, list[str]], payload: dict[str, Any]) -> Path:
+    payload = {**payload, "timings": scene.timings, "versions": scene.versions}  # this run's, never the cached ones
     body = _parts_table(scene, thumbs) + (_metrics_table(metrics) if metrics else "") + _timings_table(scene.timings)
-    page = build_viewer_html(scene_payload(manifest_path), f"REACT3D · {scene.scene_id}", body, thumbs)
+    page = build_viewer_html(payload, f"REACT3D · {scene.scene_id}", body, thumbs)
     return write_text(Path(out_path) if out_path else root / "report.html", page)

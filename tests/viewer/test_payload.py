@@ -76,3 +76,31 @@ def test_thumbnail_crops_around_the_silhouette():
     assert t.shape[0] <= 64 and t.shape[1] <= 64
     assert t[t.shape[0] // 2, t.shape[1] // 2].tolist() != [0, 0, 0]  # tinted part in the centre
     assert thumbnail(rgb, np.zeros_like(sil)) is None
+
+
+def test_report_cache_reuses_payload_but_shows_this_runs_timings(toy_scene, tmp_path):
+    """Issue 18: a re-convert reads the viewer payload (and thumbnails) back by content; the page still
+    carries the current manifest's timings, and a changed mesh is a new entry."""
+    import json
+    import shutil
+
+    from react3d_core.data import InteractiveScene
+
+    d = tmp_path / "scene"
+    shutil.copytree(toy_scene, d)
+    cache = tmp_path / "cache"
+    first = write_report(d, cache_dir=cache).read_text()
+    entries = sorted(cache.rglob("report-*.json"))
+    assert len(entries) == 1
+    m = InteractiveScene.load(d / "scene.json")
+    m.model_copy(update={"timings": {"total": 123.25}}).save(d / "scene.json")
+    stamp = entries[0].stat().st_mtime_ns
+    second = write_report(d, cache_dir=cache).read_text()
+    assert entries[0].stat().st_mtime_ns == stamp and "123.2" in second and second != first
+    assert json.loads(entries[0].read_text())["payload"]["background"]
+    from react3d_core.data import TriMesh, load_mesh, save_mesh
+
+    bg = load_mesh(d / m.background_mesh)
+    save_mesh(d / m.background_mesh, TriMesh(bg.vertices + 0.001, bg.faces, bg.colors))  # new content, new key
+    write_report(d, cache_dir=cache)
+    assert len(sorted(cache.rglob("report-*.json"))) == 2
