@@ -87,7 +87,10 @@ class S3Server:
         self.log = open(data.parent / f"s3rver-{self.port}.log", "wb")  # noqa: SIM115 - closed in close()
         self.proc = subprocess.Popen([*cmd, "--directory", str(data), "--address", "127.0.0.1", "--port",
                                       str(self.port), "--configure-bucket", bucket, "--silent"],
-                                     stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True)
+                                     stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True,
+                                     # s3rver 3.7 encrypts listing continuation tokens (> 1000 keys) with a
+                                     # cipher OpenSSL 3 (Node >= 17) keeps in its legacy provider
+                                     env={**os.environ, "NODE_OPTIONS": "--openssl-legacy-provider"})
         self.env = {"AWS_ENDPOINT_URL": f"http://127.0.0.1:{self.port}", "AWS_ACCESS_KEY_ID": "S3RVER",
                     "AWS_SECRET_ACCESS_KEY": "S3RVER", "AWS_DEFAULT_REGION": "us-east-1"}
         t0 = time.time()

@@ -98,3 +98,12 @@ def test_result_storage_follows_the_store(monkeypatch: pytest.MonkeyPatch, tmp_p
     monkeypatch.setenv("REACT3D_STORE", f"file://{tmp_path}")
     monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "ignored"))
     assert storage.cache_root() == tmp_path  # a shared folder is the store itself on every worker
+
+
+def test_listing_past_one_page(remote: str) -> None:
+    """A scene output holds > 1000 files (collision pieces): listings page with continuation tokens."""
+    from tasks import storage
+
+    fs, path = storage.filesystem(f"{remote}/many")
+    fs.pipe({f"{path}/k{i:04d}": b"" for i in range(1001)})
+    assert len(fs.find(path)) == 1001
