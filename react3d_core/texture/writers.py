@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -26,6 +27,18 @@ def format_rows(fmt: str, rows: np.ndarray) -> str:
     if not len(rows):
         return ""
     return (fmt * len(rows)) % tuple(rows.ravel().tolist())
+
+
+ROWS_PER_CHUNK = 250_000
+"""Rows formatted per ``%`` call: bounds the temporary tuple and string (a 1.25M-face background's
+3.75M ``vt`` rows at once held ~0.5 GB of Python floats) at no measurable speed cost."""
+
+
+def write_rows(fh: Any, fmt: str, rows: np.ndarray) -> None:
+    """``format_rows`` in chunks of :data:`ROWS_PER_CHUNK`, written to the open text file ``fh``."""
+    rows = np.asarray(rows)
+    for i in range(0, len(rows), ROWS_PER_CHUNK):
+        fh.write(format_rows(fmt, rows[i : i + ROWS_PER_CHUNK]))
 
 
 def encode_texture(image: np.ndarray, fmt: str = "png", png_compression: int = 3, jpeg_quality: int = 90) -> bytes:
@@ -63,9 +76,9 @@ def write_obj_folder(tm: TexturedMesh, folder: str | Path, offset: np.ndarray | 
     with atomic_dir(folder) as tmp:
         with open(tmp / "mesh.obj", "w") as fh:
             fh.write("# REACT3D baked mesh\nmtllib material.mtl\nusemtl material_0\n")
-            fh.write(format_rows("v %.7g %.7g %.7g\n", v))
-            fh.write(format_rows("vt %.7g %.7g\n", tm.uv))
-            fh.write(format_rows("f %d/%d %d/%d %d/%d\n", corners))
+            write_rows(fh, "v %.7g %.7g %.7g\n", v)
+            write_rows(fh, "vt %.7g %.7g\n", tm.uv)
+            write_rows(fh, "f %d/%d %d/%d %d/%d\n", corners)
         ext = "jpg" if texture in ("jpg", "jpeg") else "png"
         (tmp / "material.mtl").write_text(
             f"newmtl material_0\nKa 1 1 1\nKd 1 1 1\nKs 0 0 0\nd 1\nillum 1\nmap_Kd material_0.{ext}\n"
