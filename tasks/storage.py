@@ -141,9 +141,12 @@ def push_dir(local: Path, rel: str, seal: Path | None = None) -> None:
     root = remote_root()
     if root is None:
         return
-    for p in sorted(local.rglob("*")):
-        if p.is_file():
-            push_file(p, f"{rel}/{p.relative_to(local).as_posix()}")
+    fs, path = filesystem(f"{root}/{rel}")
+    if seal is not None and fs.exists(f"{path}{seal.name[len(local.name):]}"):
+        return  # folders are named by content and sealed last: this one is complete already
+    files = [p for p in sorted(local.rglob("*")) if p.is_file()]
+    if files:  # one batched, concurrent upload (an export folder holds ~1000 collision pieces)
+        fs.put([str(p) for p in files], [f"{path}/{p.relative_to(local).as_posix()}" for p in files])
     if seal is not None:
         push_file(seal, f"{rel}{seal.name[len(local.name):]}")
 
@@ -161,10 +164,11 @@ def pull_dir(rel: str, local: Path, seal_suffix: str) -> bool:
     tmp = Path(tempfile.mkdtemp(prefix=f".{local.name}.", suffix=".tmp", dir=local.parent))
     try:
         files = [f for f in fs.find(path) if not f.endswith("/")]
-        for f in files:
-            target = tmp / f[len(path):].lstrip("/")
-            target.parent.mkdir(parents=True, exist_ok=True)
-            fs.get_file(f, str(target))
+        targets = [tmp / f[len(path):].lstrip("/") for f in files]
+        for t in targets:
+            t.parent.mkdir(parents=True, exist_ok=True)
+        if files:  # one batched, concurrent download
+            fs.get(files, [str(t) for t in targets])
         try:
             os.replace(tmp, local)
         except OSError:  # another thread or process placed it first
