@@ -47,3 +47,22 @@ def test_cache_clean_prunes_the_quarantine(tmp_path: Path, monkeypatch) -> None:
     assert not old_dir.exists() and not (q / "export-ab12.seal.json").exists() and new_obj.exists()
     assert main(["cache", "clean"]) == 0
     assert not new_obj.exists()
+
+
+def test_cache_clean_prunes_collision_and_report_caches(tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
+    """Issue 18: convex decompositions and report pieces cached by content are pruned by age too."""
+    from flows.cli import main
+
+    monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setenv("PREFECT_LOCAL_STORAGE_PATH", str(tmp_path / "storage"))
+    old_col = tmp_path / "cache" / "collisions" / "ab" / "convex-ab12.npz"
+    new_rep = tmp_path / "cache" / "reports" / "cd" / "report-cd34.json"
+    for f in (old_col, new_rep):
+        f.parent.mkdir(parents=True, exist_ok=True)
+        f.write_text("x")
+    past = time.time() - 10 * 86400
+    os.utime(old_col, (past, past))
+    assert main(["cache", "clean", "--older-than", "7"]) == 0
+    assert not old_col.exists() and new_rep.exists()
+    assert main(["cache", "clean"]) == 0
+    assert not new_rep.exists()
