@@ -23,6 +23,44 @@ def _gt_faces(gt) -> dict[int, np.ndarray]:  # noqa: ANN001 - GroundTruth
     return out
 
 
+def _face_areas(mesh) -> np.ndarray:  # noqa: ANN001 - TriMesh
+    t = mesh.vertices[mesh.faces]
+    return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+
+
+def masks_on_parts_2d(scene, masks, cfg) -> dict[int, int] | None:  # noqa: ANN001 - SceneInput, PackedMasks, PipelineConfig
+    """Per movable GT part, how many masks lie on it in the GT part-id images (pixels: >= ``cause_view_precision``
+    of the mask on the part, >= ``cause_view_coverage`` of the part's pixels); None without such images
+    (rendering GT faces of the scan instead would see what the scan sees, not what the images show)."""
+    if not scene.frames or any(f.part_ids is None or not f.part_ids.path.is_file() for f in scene.frames):
+        return None
+    from react3d_core.fusion.lift import resize_mask
+    from react3d_core.perception.oracle import OracleModel
+
+    om = OracleModel(scene, cfg.perception.oracle)
+    top = max([p.part_id for p in om.gt.parts] + [0])
+    lut = np.full(top + 2, -1, np.int64)  # GT part id -> the movable part it moves with (handles -> door)
+    for pid, own in om.owner.items():
+        lut[pid] = own
+    ev = cfg.evaluation
+    out: dict[int, int] = {}
+    for f in scene.frames:
+        ms = masks.get(f.frame_id, [])
+        if not ms:
+            continue
+        img = om.part_image(f)
+        own = np.where((img >= 0) & (img <= top), lut[np.clip(img, 0, top)], -1)
+        region = np.bincount(own[own >= 0].ravel(), minlength=top + 1)
+        for mk in ms:
+            m = resize_mask(mk.mask, own.shape)
+            under = own[m]
+            cnt = np.bincount(under[under >= 0], minlength=top + 1)
+            ok = (cnt >= ev.cause_view_precision * max(int(m.sum()), 1)) & (cnt >= ev.cause_view_coverage * region) & (cnt > 0)
+            for pid in np.flatnonzero(ok):
+                out[int(pid)] = out.get(int(pid), 0) + 1
+    return out
+
+
 def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> dict[str, Any]:
     """Causes for the conversion of ``scene_path`` (with ``config``) written to ``manifest_path``."""
     from react3d_core.articulation import articulate_candidate
@@ -31,6 +69,7 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
     from react3d_core.data.masks import PackedMasks
     from react3d_core.data.parts import InteractiveScene
     from react3d_core.dedup import remove_duplicates
+    from react3d_core.fusion.lift import filled, prepare_mask, resize_mask
     from react3d_core.fusion.segment import SegmentationTrace, render_work, segment_parts
     from react3d_core.ground_truth import read_articulate3d
     from react3d_core.metrics import evaluate_scene
@@ -61,13 +100,24 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
                                           cfg, rasterizer=rast))
     valid = [p for p in parts if p is not None]
     kept_ids = {p.candidate_id for p in remove_duplicates(valid, cfg.dedup)}
-    # faces any frame sees: those with masks were rendered for lifting, the others are rendered here
-    seen = [st.faces for st in trace.stats]
-    with_masks = {st.frame_id for st in trace.stats}
-    seen += [np.unique(render_work(rast, f, cfg).face_ids) for f in scene.frames if f.frame_id not in with_masks]
+    # every frame once more at the fusion's working size: faces any frame sees, faces under each mask as predicted
+    seen: list[np.ndarray] = []
+    sets: dict[str, list[np.ndarray]] = {"raw": [], "filled": [], "lifted": []}
+    pix: dict[str, list[np.ndarray]] = {"raw": [], "filled": [], "lifted": []}
+    for f in scene.frames:
+        ids = render_work(rast, f, cfg).face_ids
+        seen.append(np.unique(ids))
+        for mk in masks.get(f.frame_id, []):
+            for kind, m in (("raw", resize_mask(mk.mask, ids.shape)), ("filled", filled(mk.mask, ids.shape, cfg)),
+                            ("lifted", prepare_mask(mk.mask, ids.shape, cfg))):
+                under = ids[m]
+                fs, px = np.unique(under[under >= 0], return_counts=True)
+                sets[kind].append(fs.astype(np.int64))
+                pix[kind].append(px)
     st = StageOutputs(
-        view_masks=[mf for s in trace.stats for mf in s.mask_faces],
-        lifted=[fs for lift in trace.lifts for fs in lift.face_sets],
+        view_masks=sets["raw"],
+        filled=sets["filled"],
+        lifted=sets["lifted"],
         seen=np.setdiff1d(np.unique(np.concatenate(seen)) if seen else np.zeros(0, np.int64), [-1]),
         proposals=[ProposalTrace(np.asarray(p.face_ids, np.int64), o.status, o.reseg_faces, o.kept_faces)
                    for p, o in zip(trace.proposals, trace.outcomes)],
@@ -75,6 +125,9 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
         candidates=[np.asarray(k.face_ids, np.int64) for k in cands],
         validated=[p is not None for p in parts],
         kept=[k.candidate_id in kept_ids for k in cands],
+        masked_2d=masks_on_parts_2d(scene, masks, cfg),
+        face_area=_face_areas(mesh),
+        view_pixels=pix["raw"], filled_pixels=pix["filled"], lifted_pixels=pix["lifted"],
     )
     manifest = InteractiveScene.load(manifest_path)
     gt = read_articulate3d(scene.gt_dir)

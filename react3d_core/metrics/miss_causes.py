@@ -7,7 +7,14 @@ from a traced run), in pipeline order; the first stage after which no output sti
 (face IoU >= ``cause_stage_iou`` with the part's *seen* faces, those in any frame's view) is the cause:
 
 ``not_seen``               no frame sees the part at all
-``not_masked``             fewer than ``cause_min_views`` 2D masks lie on the part (perception)
+``not_masked``             fewer than ``cause_min_views`` 2D masks lie on the part (perception; judged on
+                           the GT part-id images where the scene has them, else on the scan's faces)
+``off_scan_surface``       masked in the images, but in the scan the masks lie mostly on other surface:
+                           the part is not where the images show it (a glass panel missing from the
+                           scan shows the cabinet's inside; colour misregistered against the mesh)
+``filled_through``         masked, but hole filling (meant for missed handles) pulls in what lies
+                           behind the mask's holes, so the filled masks are mostly other surface: a
+                           frame-only (glass-panel) door is lifted with the cabinet's inside
 ``lost_in_lifting``        masked often enough, but fewer masks survive lifting (erosion, occlusion),
                            or the lifted faces cover under half of the part
 ``lost_in_fusion``         lifted, but no Louvain proposal is the part, merged or split (graph too weak)
@@ -42,7 +49,7 @@ from ..config.evaluation import EvaluationConfig
 from ..data.parts import OBB, Articulation
 from .geometry import axis_error_deg, joint_class, line_distance
 
-MISS_CAUSES = ("not_seen", "not_masked", "lost_in_lifting", "lost_in_fusion", "merged", "split", "no_top_view",
+MISS_CAUSES = ("not_seen", "not_masked", "off_scan_surface", "filled_through", "lost_in_lifting", "lost_in_fusion", "merged", "split", "no_top_view",
                "merged_in_reseg", "resegmentation", "clipped", "duplicate_dropped", "rejected_by_validation",
                "dropped_by_dedup", "unobserved_geometry", "other")
 JOINT_CAUSES = ("type_wrong", "sliding_not_flagged", "obb_tilt", "not_refined", "wrong_obb_axis", "far_edge",
@@ -63,13 +70,20 @@ class ProposalTrace:
 class StageOutputs:
     """Every stage's output as face-id arrays of the scan mesh (what the attribution reads).
 
-    ``view_masks``: faces under each usable 2D mask of each frame (hole-filled, not eroded);
-    ``lifted``: faces each mask was lifted to (eroded); ``seen``: faces in any frame's view;
+    ``view_masks``: faces under each 2D mask of each frame as predicted; ``filled``: the same after
+    hole filling (not eroded); ``lifted``: faces each mask was lifted to (filled, eroded); ``seen``:
+    faces in any frame's view; ``masked_2d`` (optional): per GT part id, how many masks lie on it in
+    the GT part-id images (pixels, independent of the scan); ``face_area`` (optional): area of every
+    scan face, to weigh overlaps by surface instead of face count (scan triangles vary in size: a
+    door front of 60 large triangles beside edges of 1000 small ones); ``*_pixels`` (optional, parallel
+    to the mask face sets): pixels of the mask on each of its faces, so that a mask's share on the part
+    is counted in pixels (one bled pixel on a wall's big triangle is one pixel, not the triangle);
     ``before_duplicates`` / ``candidates``: candidates before / after the segmentation's duplicate drop;
     ``validated[i]``: candidate i passed validation; ``kept[i]``: it survived assembly's dedup.
     """
 
     view_masks: list[np.ndarray]
+    filled: list[np.ndarray]
     lifted: list[np.ndarray]
     seen: np.ndarray
     proposals: list[ProposalTrace]
@@ -77,73 +91,104 @@ class StageOutputs:
     candidates: list[np.ndarray]
     validated: list[bool]
     kept: list[bool]
+    masked_2d: dict[int, int] | None = None
+    face_area: np.ndarray | None = None
+    view_pixels: list[np.ndarray] | None = None
+    filled_pixels: list[np.ndarray] | None = None
+    lifted_pixels: list[np.ndarray] | None = None
 
 
-def _overlaps(sets: list[np.ndarray], part: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Per set: |S & P|, |S|, IoU with P (P and every S unique face ids)."""
-    inter = np.array([len(np.intersect1d(s, part, assume_unique=True)) for s in sets], float)
-    size = np.array([len(s) for s in sets], float)
-    union = size + len(part) - inter
+def _size(ids: np.ndarray, w: np.ndarray | None) -> float:
+    """Area of a face set (face count without areas)."""
+    return float(w[ids].sum()) if w is not None else float(len(ids))
+
+
+def _overlaps(sets: list[np.ndarray], part: np.ndarray, w: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per set: area of S & P, area of S, IoU with P (P and every S unique face ids; areas by ``w``)."""
+    inter = np.array([_size(np.intersect1d(s, part, assume_unique=True), w) for s in sets], float)
+    size = np.array([_size(s, w) for s in sets], float)
+    union = size + _size(part, w) - inter
     return inter, size, np.divide(inter, union, out=np.zeros_like(inter), where=union > 0)
 
 
-def _best(sets: list[np.ndarray], part: np.ndarray) -> tuple[int, float]:
+def _best(sets: list[np.ndarray], part: np.ndarray, w: np.ndarray | None = None) -> tuple[int, float]:
     if not sets:
         return -1, 0.0
-    iou = _overlaps(sets, part)[2]
+    iou = _overlaps(sets, part, w)[2]
     i = int(np.argmax(iou))
     return i, float(iou[i])
 
 
-def _on_part(sets: list[np.ndarray], part: np.ndarray, cfg: EvaluationConfig) -> int:
-    """How many sets lie on the part: mostly its faces and covering a share of it."""
+def _on_part(sets: list[np.ndarray], part: np.ndarray, cfg: EvaluationConfig, w: np.ndarray | None = None,
+             pixels: list[np.ndarray] | None = None) -> int:
+    """How many masks lie on the part: mostly on it (share of the mask's pixels, else of its faces'
+    area) and covering a share of its surface."""
     if not sets or not len(part):
         return 0
-    inter, size, _ = _overlaps(sets, part)
-    prec = np.divide(inter, size, out=np.zeros_like(inter), where=size > 0)
-    return int(((prec >= cfg.cause_view_precision) & (inter >= cfg.cause_view_coverage * len(part))).sum())
+    inter, size, _ = _overlaps(sets, part, w)
+    if pixels is not None:
+        on = [np.isin(s, part, assume_unique=True) for s in sets]
+        inter_px = np.array([float(px[o].sum()) for px, o in zip(pixels, on)])
+        size_px = np.array([float(px.sum()) for px in pixels])
+        prec = np.divide(inter_px, size_px, out=np.zeros_like(inter_px), where=size_px > 0)
+    else:
+        prec = np.divide(inter, size, out=np.zeros_like(inter), where=size > 0)
+    return int(((prec >= cfg.cause_view_precision) & (inter >= cfg.cause_view_coverage * _size(part, w))).sum())
 
 
-def miss_cause(gt_faces: np.ndarray, eval_iou: float, st: StageOutputs, cfg: EvaluationConfig) -> tuple[str, dict[str, Any]]:
+def miss_cause(gt_faces: np.ndarray, eval_iou: float, st: StageOutputs, cfg: EvaluationConfig,
+               part_id: int | None = None) -> tuple[str, dict[str, Any]]:
     """The stage where a GT part (all its faces, handles included) was lost, and the numbers that say so."""
+    w = st.face_area
     part = np.intersect1d(np.unique(np.asarray(gt_faces, np.int64)), st.seen)
+    area = _size(part, w)
     info: dict[str, Any] = {"seen_faces": int(len(part)), "eval_iou": float(eval_iou)}
     if not len(part):
         return "not_seen", info
     thr = cfg.cause_stage_iou
     # downstream first: a later stage holding the part tells where it went missing after that
-    ci, c_iou = _best(st.candidates, part)
+    ci, c_iou = _best(st.candidates, part, w)
     info["candidate_iou"] = round(c_iou, 3)
     if c_iou >= thr:
-        holders = [i for i, s in enumerate(st.candidates) if _overlaps([s], part)[2][0] >= thr]
+        holders = [i for i, s in enumerate(st.candidates) if _overlaps([s], part, w)[2][0] >= thr]
         if not any(st.validated[i] for i in holders):
             return "rejected_by_validation", info
         if not any(st.kept[i] for i in holders):
             return "dropped_by_dedup", info
         return ("unobserved_geometry" if eval_iou < cfg.miss_iou else "other"), info
-    if _best(st.before_duplicates, part)[1] >= thr:
+    if _best(st.before_duplicates, part, w)[1] >= thr:
         return "duplicate_dropped", info
-    n_masked = _on_part(st.view_masks, part, cfg)
-    n_lifted = _on_part(st.lifted, part, cfg)
-    lifted_cover = len(np.intersect1d(np.unique(np.concatenate(st.lifted)) if st.lifted else np.zeros(0, np.int64), part,
-                                      assume_unique=True)) / len(part)
-    info.update(masked_views=n_masked, lifted_views=n_lifted, lifted_cover=round(lifted_cover, 3))
-    if n_masked < cfg.cause_min_views:
+    n_masked = _on_part(st.view_masks, part, cfg, w, st.view_pixels)
+    n_filled = _on_part(st.filled, part, cfg, w, st.filled_pixels)
+    n_lifted = _on_part(st.lifted, part, cfg, w, st.lifted_pixels)
+    lifted_all = np.unique(np.concatenate(st.lifted)) if st.lifted else np.zeros(0, np.int64)
+    lifted_cover = _size(np.intersect1d(lifted_all, part, assume_unique=True), w) / area
+    info.update(masked_views=n_masked, filled_views=n_filled, lifted_views=n_lifted, lifted_cover=round(lifted_cover, 3))
+    if st.masked_2d is not None and part_id is not None:
+        info["masked_views_2d"] = n2d = int(st.masked_2d.get(part_id, 0))
+        if n2d < cfg.cause_min_views:
+            return "not_masked", info
+        if n_masked < cfg.cause_min_views:
+            return "off_scan_surface", info
+    elif n_masked < cfg.cause_min_views:
         return "not_masked", info
+    if n_filled < cfg.cause_min_views:
+        return "filled_through", info
     if n_lifted < cfg.cause_min_views or lifted_cover < 0.5:
         return "lost_in_lifting", info
     props = [p.faces for p in st.proposals]
-    pi, p_iou = _best(props, part)
+    pi, p_iou = _best(props, part, w)
     info["proposal_iou"] = round(p_iou, 3)
     if p_iou < thr:
         if props:
-            inter, size, _ = _overlaps(props, part)
+            inter, size, _ = _overlaps(props, part, w)
             prec = np.divide(inter, size, out=np.zeros_like(inter), where=size > 0)
-            if ((inter >= thr * len(part)) & (prec < thr)).any():
+            if ((inter >= thr * area) & (prec < thr)).any():
                 return "merged", info
             inside = prec >= thr
-            if inside.sum() >= 2 and len(np.intersect1d(np.unique(np.concatenate([props[i] for i in np.flatnonzero(inside)])),
-                                                        part)) >= thr * len(part):
+            held = np.unique(np.concatenate([props[i] for i in np.flatnonzero(inside)])) if inside.any() else lifted_all[:0]
+            if inside.sum() >= 2 and _size(np.intersect1d(held, part, assume_unique=True), w) >= thr * area:
                 return "split", info
         return "lost_in_fusion", info
     p = st.proposals[pi]
@@ -152,10 +197,10 @@ def miss_cause(gt_faces: np.ndarray, eval_iou: float, st: StageOutputs, cfg: Eva
         return "no_top_view", info
     if p.status == "claimed":
         return "merged_in_reseg", info
-    r_inter, r_size, r_iou = (x[0] for x in _overlaps([p.reseg_faces], part))
+    r_inter, r_size, r_iou = (x[0] for x in _overlaps([np.unique(p.reseg_faces)], part, w))
     info["reseg_iou"] = round(float(r_iou), 3)
     if p.status == "reseg_empty" or r_iou < thr:
-        grown = r_inter >= thr * len(part) and r_size > 0 and r_inter / r_size < thr
+        grown = r_inter >= thr * area and r_size > 0 and r_inter / r_size < thr
         return ("merged_in_reseg" if grown else "resegmentation"), info
     return "clipped", info
 
@@ -230,7 +275,7 @@ def attribute_scene(gt_faces: dict[int, np.ndarray], gt_arts: dict[int, Articula
     for r in rows:
         pid = int(r["gt_part"])
         if not r["matched"] or r["iou"] < cfg.miss_iou:
-            cause, info = miss_cause(gt_faces[pid], float(r["iou"]), st, cfg)
+            cause, info = miss_cause(gt_faces[pid], float(r["iou"]), st, cfg, pid)
             counts["miss"][cause] += 1
             parts.append({"gt_part": pid, "kind": "miss", "causes": [cause], **info})
             continue

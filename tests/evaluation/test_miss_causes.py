@@ -33,13 +33,19 @@ PLANTED = {
     11: ("resegmentation", r(125, 135)),
     12: ("lost_in_fusion", r(135, 145)),
     13: ("unobserved_geometry", r(145, 155)),
+    14: ("filled_through", r(160, 170)),
+    15: ("off_scan_surface", r(190, 200)),
 }
 
 
 def stage_outputs() -> StageOutputs:
     ok = [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13]  # parts masked and lifted in 3 views each
     masks = [PLANTED[1][1]] + [PLANTED[2][1]] * 3 + [PLANTED[k][1] for k in ok for _ in range(3)]
-    lifted = [PLANTED[2][1]] + [PLANTED[k][1] for k in ok for _ in range(3)]
+    glass = np.concatenate([r(160, 170), r(170, 190)])  # a door's frame and, through its empty panel, 20 faces behind
+    masks += [r(160, 170)] * 3
+    filled = [f for f in masks if not (len(f) and f[0] == 160)] + [glass] * 3
+    masks += [np.concatenate([r(190, 192), r(170, 190)])] * 3  # on part 15 in the images, on other faces in the scan
+    lifted = [PLANTED[2][1]] + [PLANTED[k][1] for k in ok for _ in range(3)] + [glass] * 3
     proposals = [
         ProposalTrace(np.concatenate([r(30, 40), r(40, 55)]), "candidate", r(30, 55), r(30, 55)),  # part 3 + 15 faces of wall
         ProposalTrace(r(55, 59), "candidate", r(55, 59), r(55, 59)),                                # part 4 in two pieces
@@ -58,7 +64,8 @@ def stage_outputs() -> StageOutputs:
     validated = [not (len(f) and f[0] == 75) for f in cands]
     kept = [v and not (len(f) and f[0] == 85) for f, v in zip(cands, validated)]
     seen = np.setdiff1d(r(0, 200), r(0, 10))
-    return StageOutputs(masks, lifted, seen, proposals, before, cands, validated, kept)
+    masked_2d = {pid: (1 if pid == 1 else 0 if pid == 0 else 3) for pid in PLANTED}  # from GT part-id images
+    return StageOutputs(masks, filled, lifted, seen, proposals, before, cands, validated, kept, masked_2d)
 
 
 def test_each_planted_miss_is_attributed_to_its_stage() -> None:
@@ -72,6 +79,10 @@ def test_each_planted_miss_is_attributed_to_its_stage() -> None:
     assert res["counts"]["miss"]["other"] == 0 and sum(res["counts"]["miss"].values()) == len(PLANTED)
     merged = next(p for p in res["parts"] if p["gt_part"] == 3)
     assert merged["proposal_iou"] == 0.4 and merged["masked_views"] == 3  # 10 of the proposal's 25 faces
+    # without GT images the scan's faces judge the masks: part 15's masks are then simply not on it
+    st.masked_2d = None
+    no_images = {p["gt_part"]: p["causes"][0] for p in attribute_scene(gt_faces, {}, rows, [], st, CFG)["parts"]}
+    assert no_images[15] == "not_masked" and no_images[14] == "filled_through"
     pooled = pool_counts([res, res])
     assert pooled["miss"]["split"] == 2 and pooled["joint"]["far_edge"] == 0
 
@@ -105,3 +116,35 @@ def test_joint_causes_on_hand_made_boxes() -> None:
     assert joint_causes(_pj("revolute", (0.1, 0.05, 1), (0.0, 0.01, 0.4), _door_obb(), flat=False), hinge, CFG) == ["not_refined"]
     assert joint_causes(_pj("prismatic", (0, -1, 0), (0.3, 0, 0.4), _door_obb()), hinge, CFG) == ["type_wrong"]
     assert joint_causes(_pj("revolute", (0, 0, 1), (0.0, 0.01, 0.4), _door_obb()), hinge, CFG) == []
+
+
+def test_overlaps_weigh_faces_by_area() -> None:
+    """A door front of 2 large triangles (10 m^2 each, for round numbers) and 18 small edge triangles:
+    masks showing the front cover 95 % of its surface but 10 % of its faces; by area they are on it."""
+    part = r(0, 20)
+    area = np.where(part < 2, 10.0, 0.1 / 18 * 10)  # edges: 1 m^2 in all
+    front = r(0, 2)
+    st = StageOutputs(view_masks=[front] * 3, filled=[front] * 3, lifted=[front] * 3, seen=part, proposals=[],
+                      before_duplicates=[], candidates=[], validated=[], kept=[])
+    rows = [{"gt_part": 0, "iou": 0.0, "matched": False, "pred": None}]
+    by_count = attribute_scene({0: part}, {}, rows, [], st, CFG)["parts"][0]
+    assert by_count["causes"] == ["not_masked"] and by_count["masked_views"] == 0
+    st.face_area = area
+    by_area = attribute_scene({0: part}, {}, rows, [], st, CFG)["parts"][0]
+    assert by_area["masked_views"] == 3 and by_area["lifted_cover"] == round(20 / 21, 3)
+    assert by_area["causes"] == ["lost_in_fusion"]  # lifted well, but no proposal holds it
+
+
+def test_mask_share_on_the_part_counts_pixels() -> None:
+    """A door mask bleeding one pixel onto a wall triangle of 50 m^2: by face area it is mostly wall,
+    by pixels (100 on the door, 1 on the wall) it is on the door."""
+    part, wall = r(0, 2), r(2, 3)
+    area = np.array([1.0, 1.0, 50.0])
+    mask = np.array([0, 1, 2])
+    st = StageOutputs(view_masks=[mask] * 2, filled=[mask] * 2, lifted=[mask] * 2, seen=np.concatenate([part, wall]),
+                      proposals=[], before_duplicates=[], candidates=[], validated=[], kept=[], face_area=area)
+    rows = [{"gt_part": 0, "iou": 0.0, "matched": False, "pred": None}]
+    assert attribute_scene({0: part}, {}, rows, [], st, CFG)["parts"][0]["masked_views"] == 0
+    px = [np.array([50, 50, 1])] * 2
+    st.view_pixels, st.filled_pixels, st.lifted_pixels = px, px, px
+    assert attribute_scene({0: part}, {}, rows, [], st, CFG)["parts"][0]["masked_views"] == 2
