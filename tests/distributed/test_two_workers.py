@@ -95,6 +95,14 @@ def _normalized_manifest(path: str | Path, text: str) -> dict[str, Any]:
     return m
 
 
+def _diff_paths(a: Any, b: Any, at: str = "") -> list[str]:
+    """Where two JSON values differ, as /key/paths (a readable assertion message)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        return [p for k in sorted(set(a) | set(b), key=str) for p in
+                ([f"{at}/{k}"] if (k in a) != (k in b) else _diff_paths(a[k], b[k], f"{at}/{k}"))]
+    return [] if a == b else [at or "/"]
+
+
 def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Path, tmp_path: Path) -> None:
     if s3rver_command() is None:
         pytest.skip("s3rver not installed (bash scripts/setup.sh test)")
@@ -125,8 +133,8 @@ def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Pat
                 assert rows[name]["status"] == "ok", rows
                 local = _RESULTS["local"] / name / "scene.json"
                 remote = f"{out}/{name}/scene.json"
-                assert _normalized_manifest(remote, storage.read_text(remote)) == \
-                    _normalized_manifest(local, local.read_text()), name
+                a, b = _normalized_manifest(remote, storage.read_text(remote)), _normalized_manifest(local, local.read_text())
+                assert a == b, f"{name}: manifests differ at {_diff_paths(a, b)[:10]}"
                 fs, path = storage.filesystem(f"{out}/{name}")
                 remote_files = {p[len(path) + 1:]: hashlib.sha256(fs.cat_file(p)).hexdigest() for p in fs.find(path)}
                 local_files = {p.relative_to(local.parent).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
