@@ -73,7 +73,8 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
     from react3d_core.fusion.segment import SegmentationTrace, render_work, segment_parts
     from react3d_core.ground_truth import read_articulate3d
     from react3d_core.metrics import evaluate_scene
-    from react3d_core.metrics.miss_causes import PredictedJoint, ProposalTrace, StageOutputs, attribute_scene
+    from react3d_core.metrics.miss_causes import (PredictedJoint, ProposalTrace, StageOutputs, attribute_scene,
+                                                 coincident_parts)
     from tasks.perception import get_perception, perceive_body
     from tasks.scene import rasterizer, scan_mesh, scene_input
     from tasks.store import get
@@ -139,7 +140,15 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
         rows = sm.parts
     preds = [PredictedJoint(o.articulation, o.initial_articulation, o.obb, np.asarray(o.front_normal, float),
                             is_flat(o.obb, cfg.articulation.flat_ratio)) for o in manifest.objects]
-    out = attribute_scene(_gt_faces(gt), {p.part_id: p.articulation for p in gt.movable}, rows, preds, st, cfg.evaluation)
+    faces = _gt_faces(gt)
+    boxes = {}
+    for pid, f in faces.items():
+        f = f[(f >= 0) & (f < mesh.n_faces)]
+        if len(f):
+            v = mesh.vertices[mesh.faces[f].ravel()]
+            boxes[pid] = (v.min(0), v.max(0))
+    out = attribute_scene(faces, {p.part_id: p.articulation for p in gt.movable}, rows, preds, st, cfg.evaluation,
+                          coincident=coincident_parts(boxes))
     out["stages"] = {"masks": len(st.view_masks), "proposals": len(st.proposals), "candidates": len(cands),
                      "validated": len(valid), "kept": len(kept_ids), "objects": len(manifest.objects)}
     return out

@@ -6,6 +6,9 @@ computed on the scan's faces from the stages' own outputs (:class:`StageOutputs`
 from a traced run), in pipeline order; the first stage after which no output still holds the part
 (face IoU >= ``cause_stage_iou`` with the part's *seen* faces, those in any frame's view) is the cause:
 
+``coincident_gt``          the GT part shares its place with another GT part (their boxes overlap by more
+                           than half the smaller): two objects stacked in one spot by the scene
+                           generator, whose surfaces z-fight; no pipeline can return both
 ``not_seen``               no frame sees the part at all
 ``not_masked``             fewer than ``cause_min_views`` 2D masks lie on the part (perception; judged on
                            the GT part-id images where the scene has them, else on the scan's faces)
@@ -49,7 +52,7 @@ from ..config.evaluation import EvaluationConfig
 from ..data.parts import OBB, Articulation
 from .geometry import axis_error_deg, joint_class, line_distance
 
-MISS_CAUSES = ("not_seen", "not_masked", "off_scan_surface", "filled_through", "lost_in_lifting", "lost_in_fusion", "merged", "split", "no_top_view",
+MISS_CAUSES = ("coincident_gt", "not_seen", "not_masked", "off_scan_surface", "filled_through", "lost_in_lifting", "lost_in_fusion", "merged", "split", "no_top_view",
                "merged_in_reseg", "resegmentation", "clipped", "duplicate_dropped", "rejected_by_validation",
                "dropped_by_dedup", "unobserved_geometry", "other")
 JOINT_CAUSES = ("type_wrong", "sliding_not_flagged", "obb_tilt", "not_refined", "wrong_obb_axis", "far_edge",
@@ -258,15 +261,34 @@ def joint_causes(pred: PredictedJoint, gt: Articulation, cfg: EvaluationConfig) 
     return out
 
 
+def coincident_parts(boxes: dict[int, tuple[np.ndarray, np.ndarray]], share: float = 0.5) -> set[int]:
+    """GT parts whose axis-aligned box overlaps another GT part's by more than ``share`` of the smaller
+    volume (a flat part's box is grown to 1 cm thick so coplanar doors count)."""
+    ids = list(boxes)
+    if len(ids) < 2:
+        return set()
+    lo = np.array([boxes[i][0] for i in ids], float)
+    hi = np.array([boxes[i][1] for i in ids], float)
+    pad = np.maximum(0.01 - (hi - lo), 0.0) / 2
+    lo, hi = lo - pad, hi + pad
+    inter = np.prod(np.clip(np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None]), 0, None), axis=2)
+    vol = np.prod(hi - lo, axis=1)
+    over = inter > share * np.minimum(vol[:, None], vol[None])
+    np.fill_diagonal(over, False)
+    return {ids[k] for k in np.flatnonzero(over.any(1))}
+
+
 def empty_counts() -> dict[str, dict[str, int]]:
     """The stable JSON shape: every cause key present, zero when it did not occur."""
     return {"miss": {k: 0 for k in MISS_CAUSES}, "joint": {k: 0 for k in JOINT_CAUSES}}
 
 
 def attribute_scene(gt_faces: dict[int, np.ndarray], gt_arts: dict[int, Articulation], rows: list[dict[str, Any]],
-                    preds: list[PredictedJoint], st: StageOutputs, cfg: EvaluationConfig) -> dict[str, Any]:
+                    preds: list[PredictedJoint], st: StageOutputs, cfg: EvaluationConfig,
+                    coincident: set[int] | None = None) -> dict[str, Any]:
     """Causes for one scene. ``rows``: the evaluation's per-GT-part rows at one threshold
-    (``gt_part``, ``iou``, ``matched``, ``pred``, ``oe``, ``md``); ``preds`` indexed like ``row['pred']``.
+    (``gt_part``, ``iou``, ``matched``, ``pred``, ``oe``, ``md``); ``preds`` indexed like ``row['pred']``;
+    ``coincident``: GT parts stacked on another GT part (:func:`coincident_parts`), a fault of the data.
 
     Returns ``{"counts": {"miss": {cause: n}, "joint": {cause: n}}, "parts": [...]}``: one entry per
     traced part with its ``gt_part``, ``kind`` (miss | joint), ``causes`` and the stage numbers."""
@@ -275,7 +297,10 @@ def attribute_scene(gt_faces: dict[int, np.ndarray], gt_arts: dict[int, Articula
     for r in rows:
         pid = int(r["gt_part"])
         if not r["matched"] or r["iou"] < cfg.miss_iou:
-            cause, info = miss_cause(gt_faces[pid], float(r["iou"]), st, cfg, pid)
+            if coincident and pid in coincident:
+                cause, info = "coincident_gt", {"eval_iou": float(r["iou"])}
+            else:
+                cause, info = miss_cause(gt_faces[pid], float(r["iou"]), st, cfg, pid)
             counts["miss"][cause] += 1
             parts.append({"gt_part": pid, "kind": "miss", "causes": [cause], **info})
             continue

@@ -8,7 +8,7 @@ import numpy as np
 from react3d_core.config.evaluation import EvaluationConfig
 from react3d_core.data.parts import OBB, Articulation
 from react3d_core.metrics.miss_causes import (JOINT_CAUSES, MISS_CAUSES, PredictedJoint, ProposalTrace, StageOutputs,
-                                             attribute_scene, joint_causes, pool_counts)
+                                             attribute_scene, coincident_parts, joint_causes, pool_counts)
 
 CFG = EvaluationConfig()
 
@@ -148,3 +148,16 @@ def test_mask_share_on_the_part_counts_pixels() -> None:
     px = [np.array([50, 50, 1])] * 2
     st.view_pixels, st.filled_pixels, st.lifted_pixels = px, px, px
     assert attribute_scene({0: part}, {}, rows, [], st, CFG)["parts"][0]["masked_views"] == 2
+
+
+def test_stacked_gt_parts_are_the_data_s_fault() -> None:
+    """Two wall-cabinet doors generated in one spot (a scene-synthesizer kitchen stacks cabinets) and a
+    door beside them: the stacked pair is flagged, the neighbour is not; a flagged miss is not traced."""
+    door = (np.array([0.0, 0.0, 1.3]), np.array([0.5, 0.02, 2.0]))
+    boxes = {1: door, 2: (door[0] + [0.01, 0, 0], door[1] + [0.01, 0, 0]), 3: (door[0] + [0.5, 0, 0], door[1] + [0.5, 0, 0]),
+             4: (np.array([0.0, 0.0, 0.0]), np.array([0.5, 0.0, 0.7]))}  # 4: zero-thickness front below them
+    assert coincident_parts(boxes) == {1, 2}
+    st = StageOutputs([], [], [], np.zeros(0, np.int64), [], [], [], [], [])
+    rows = [{"gt_part": 1, "iou": 0.2, "matched": False, "pred": None}]
+    res = attribute_scene({1: r(0, 10)}, {}, rows, [], st, CFG, coincident={1, 2})
+    assert res["parts"][0]["causes"] == ["coincident_gt"] and res["counts"]["miss"]["coincident_gt"] == 1
