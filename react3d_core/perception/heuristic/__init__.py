@@ -20,7 +20,7 @@ from .fronts import FrontRules
 from .image_fronts import params_from_config
 from .sliding import SlidingRules
 
-STAGE_VERSION = "4"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames; 4: sliding doors
+STAGE_VERSION = "5"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames; 4: sliding doors; 5: straight seams by line median, handle shadows filled, texture-adaptive clutter
 
 
 def make_heuristic(scene: SceneInput, config: PerceptionConfig) -> Perception:

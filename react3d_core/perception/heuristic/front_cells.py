@@ -11,6 +11,7 @@ thresholds are in metres or brightness ratios (the orthophoto is exposure-normal
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass, field
 
 import cv2
@@ -36,6 +37,7 @@ class CellParams:
     max_clutter: float = 0.18        # fraction of a cell's pixels off its local background (posters, tiles, shelves)
     outline_margin: float = 0.02     # m: colour blobs this close to the plane's outline are not handles
     texture_factor: float = 3.0      # handle/seam thresholds rise to this many times the plane's median response
+    seam_z: float = 15.0             # a straight seam: the line's median brightness dips this many noise units below its neighbours
     max_depth: int = 6               # guillotine recursion depth
 
 
@@ -63,6 +65,7 @@ class Cell:
     r1: int
     handles: list[Handle] = field(default_factory=list)
     cut_sides: int = 0
+    seam_cuts: int = 0  # of those cuts, straight seams along the whole cell (``_dip_cut``)
 
 
 def _valleys(g: np.ndarray, axis: int, contrast: float) -> np.ndarray:
@@ -121,15 +124,25 @@ def off_background(o: Orthophoto, p: CellParams) -> np.ndarray:
     return np.linalg.norm(c.astype(np.float32) - bg.astype(np.float32), axis=-1) / 128.0
 
 
+def off_threshold(diff: np.ndarray, valid: np.ndarray, p: CellParams) -> float:
+    """Colour distance above which a pixel is off its background: ``handle_contrast``, raised on
+    textured planes (wood grain deviates everywhere) to ``texture_factor`` x the plane's median."""
+    if not valid.any():
+        return p.handle_contrast
+    return max(p.handle_contrast, p.texture_factor * float(np.median(diff[valid])))
+
+
 def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.ndarray | None = None,
-                 protrusion: np.ndarray | None = None) -> list[Handle]:
-    """Compact elongated blobs whose colour differs from the local background (see module docstring)."""
+                 protrusion: np.ndarray | None = None, outline: np.ndarray | None = None) -> list[Handle]:
+    """Compact elongated blobs whose colour differs from the local background (see module docstring).
+    Colour blobs keep ``outline_margin`` inside ``coverage`` (colour beside a scanning shadow is
+    misregistered); a handle must lie inside ``outline`` (coverage with handle shadows filled; default
+    ``coverage``)."""
     valid = o.n_views > 0
     if valid.sum() < 100:
         return []
     diff = off_background(o, p) if diff is None else diff
-    # textured fronts (wood grain) deviate everywhere: a handle stands out of the plane's own texture
-    thr = max(p.handle_contrast, p.texture_factor * float(np.median(diff[valid])))
+    thr = off_threshold(diff, valid, p)
     # the plane's own outline (a worktop edge's shadow, the floor line) is no handle: keep 2 cm away
     edge = max(1, int(round(p.outline_margin / o.res)))
     inner = cv2.erode(coverage.astype(np.uint8), np.ones((2 * edge + 1, 2 * edge + 1), np.uint8)).astype(bool)
@@ -156,7 +169,7 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.nd
         # a handle sits on the front: mesh coverage around it on both sides across its length
         pad = max(2, int(0.02 / o.res))
         r0, r1, c0, c1 = max(0, y - pad), min(lab.shape[0], y + h + pad), max(0, x - pad), min(lab.shape[1], x + w + pad)
-        if coverage[r0:r1, c0:c1].mean() < 0.4:
+        if (coverage if outline is None else outline)[r0:r1, c0:c1].mean() < 0.4:
             continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1)))
@@ -176,12 +189,13 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], p: C
     for h in handles:
         blocked_c[h.box[0]:h.box[2]] = True
         blocked_r[h.box[1]:h.box[3]] = True
-    cells = _split(root, vert, horiz, coverage, p, min_px, 0, blocked_c, blocked_r, handles)
+    g = np.where(o.n_views > 0, o.color.mean(-1), np.nan)  # unseen pixels carry no brightness
+    cells = _split(root, vert, horiz, coverage, p, min_px, 0, blocked_c, blocked_r, handles, g)
     for c in cells:
         c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     out: list[Cell] = []
     for c in cells:
-        out += _split_handles(c, vert, horiz, coverage, min_px)
+        out += _split_handles(c, vert, horiz, coverage, min_px, g, p)
     return out
 
 
@@ -210,18 +224,58 @@ def _best_cut(ev: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellPa
     return i + min_px, float(inner[i])
 
 
+def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams) -> np.ndarray:
+    """Per line across ``axis``: how far its median brightness dips below the lines beside it (within
+    ``min_px``), in noise units. A seam is a straight dark line along the whole cell, so the median over
+    the line dips, while wood grain, noise and reflections wander and average out (boolean valley counts
+    saturate on strongly grained fronts). Lines less than half covered score 0."""
+    cov = cov & np.isfinite(g)
+    n = cov.sum(axis)
+    if not n.any():
+        return np.zeros(len(n))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN lines are handled below
+        prof = np.nanmedian(np.where(cov, g, np.nan), axis)
+    ok = (n >= 0.5 * n.max()) & np.isfinite(prof)
+    if ok.sum() < 3:
+        return np.zeros(len(n))
+    prof = np.where(ok, prof, np.median(prof[ok]))
+    dip = ndimage.median_filter(prof, size=2 * min_px + 1, mode="nearest") - prof
+    noise = max(1.4826 * float(np.median(np.abs(dip[ok] - np.median(dip[ok])))), 1e-3)
+    return np.where(ok & (dip >= p.seam_contrast), dip / noise, 0.0)
+
+
+def _dip_cut(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams,
+             blocked: np.ndarray) -> tuple[int, float]:
+    """Best split line by ``_dip_scores`` (index in the cell, score), keeping ``min_px`` on each side
+    and off ``blocked`` lines."""
+    if cov.shape[1 - axis] <= 2 * min_px:
+        return -1, 0.0
+    z = np.where(blocked, 0.0, _dip_scores(g, cov, axis, min_px, p))
+    inner = z[min_px:len(z) - min_px]
+    i = int(np.argmax(inner))
+    return i + min_px, float(inner[i])
+
+
 def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: CellParams, min_px: int,
-           depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle]) -> list[Cell]:
-    """Recursive guillotine split at the most prominent seam. Inside a cell holding handles, a
-    horizontal cut must leave a handle on both sides (glossy fronts reflect horizontal table and
-    shelf edges at a constant height; a drawer above a door carries its own handle)."""
+           depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray) -> list[Cell]:
+    """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at the most
+    prominent seam by valley counts. Inside a cell holding handles, a horizontal cut must leave a handle
+    on both sides (glossy fronts reflect horizontal table and shelf edges at a constant height; a drawer
+    above a door carries its own handle)."""
     if depth >= p.max_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
-    cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
-    ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])  # profile over rows
-    sc_v = sc_v if sc_v >= p.seam_prominence else 0.0
-    sc_h = sc_h if sc_h >= p.seam_prominence_h else 0.0
+    cv_, sc_v = _dip_cut(g[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
+    ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
+    sc_v = sc_v if sc_v >= p.seam_z else 0.0
+    sc_h = sc_h if sc_h >= p.seam_z else 0.0
+    straight = int(max(sc_v, sc_h) > 0.0)
+    if not straight:
+        cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])
+        ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
+        sc_v = sc_v if sc_v >= p.seam_prominence else 0.0
+        sc_h = sc_h if sc_h >= p.seam_prominence_h else 0.0
     mine = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     if sc_h and mine:
         cut = c.r0 + ch_
@@ -229,17 +283,32 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
             sc_h = 0.0
     if max(sc_v, sc_h) == 0.0:
         return [c]
+    n, k = c.cut_sides + 1, c.seam_cuts + straight
     if sc_v >= sc_h:
-        a = Cell(c.c0, c.r0, c.c0 + cv_, c.r1, cut_sides=c.cut_sides + 1)
-        b = Cell(c.c0 + cv_ + 1, c.r0, c.c1, c.r1, cut_sides=c.cut_sides + 1)
+        a = Cell(c.c0, c.r0, c.c0 + cv_, c.r1, cut_sides=n, seam_cuts=k)
+        b = Cell(c.c0 + cv_ + 1, c.r0, c.c1, c.r1, cut_sides=n, seam_cuts=k)
     else:
-        a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=c.cut_sides + 1)
-        b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=c.cut_sides + 1)
-    return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine)
-            + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine))
+        a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=n, seam_cuts=k)
+        b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=n, seam_cuts=k)
+    return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g)
+            + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g))
 
 
-def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int) -> list[Cell]:
+def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: CellParams) -> int:
+    """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the strongest straight
+    seam (``_dip_scores`` ≥ 3 noise units), else the most seam-like line by valley counts, else the middle."""
+    if hi - lo < 1:
+        return (lo + hi) // 2
+    z = _dip_scores(g, cov, axis, min_px, p)[lo:hi]
+    if z.max() >= 3.0:
+        return lo + int(np.argmax(z))
+    sl = (slice(None), slice(lo, hi)) if axis == 0 else (slice(lo, hi), slice(None))
+    prof = _profile(ev[sl], cov[sl], axis)
+    return lo + int(np.argmax(prof)) if prof.max() > 0.2 else (lo + hi) // 2
+
+
+def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: np.ndarray,
+                   p: CellParams) -> list[Cell]:
     """Split a cell between consecutive handles (side by side: at the best column between them;
     stacked: at the best row), recursively, so every cell ends with at most one handle per row/column."""
     if len(c.handles) < 2:
@@ -256,10 +325,10 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         lo, hi = int(hs[k].box[2]), int(hs[k + 1].box[0])
         if hi - lo < 2:
             lo, hi = int(xs[k]), int(xs[k + 1])
-        prof = _profile(vert[c.r0:c.r1, lo:hi], cov[c.r0:c.r1, lo:hi], 0) if hi > lo else np.zeros(0)
-        cut = lo + int(np.argmax(prof)) if len(prof) and prof.max() > 0.2 else (lo + hi) // 2
-        a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1)
-        b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1)
+        rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
+        cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p)
+        a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
+        b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):
             return [c]  # handles overlapping across the cut (a bar seen twice): nothing to separate
     else:
@@ -269,10 +338,10 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         lo, hi = int(hs[k].box[3]), int(hs[k + 1].box[1])
         if hi - lo < 2:
             lo, hi = int(ys[k]), int(ys[k + 1])
-        prof = _profile(horiz[lo:hi, c.c0:c.c1], cov[lo:hi, c.c0:c.c1], 1) if hi > lo else np.zeros(0)
-        cut = lo + int(np.argmax(prof)) if len(prof) and prof.max() > 0.2 else (lo + hi) // 2
-        a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1)
-        b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1)
+        rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
+        cut = c.r0 + _between(g[rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p)
+        a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
+        b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1):
             return [c]
-    return _split_handles(a, vert, horiz, cov, min_px) + _split_handles(b, vert, horiz, cov, min_px)
+    return _split_handles(a, vert, horiz, cov, min_px, g, p) + _split_handles(b, vert, horiz, cov, min_px, g, p)

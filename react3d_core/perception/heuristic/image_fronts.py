@@ -20,7 +20,7 @@ from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
 from .facets import face_normals
-from .front_cells import Cell, CellParams, find_handles, off_background, split_cells
+from .front_cells import Cell, CellParams, find_handles, off_background, off_threshold, split_cells
 from .fronts import Front, FrontRules, _joint, _neighbours, doors_in_rows
 from .orthophoto import ColourCalibration, Orthophoto, OrthoParams, build_orthophotos
 from .planes import Plane, vertical_planes
@@ -35,6 +35,7 @@ class ImageFrontParams:
     min_plane_area: float = 0.08      # m²
     face_depth: tuple[float, float] = (-0.02, 0.07)  # m behind / in front of the plane taken into a front
     min_tile_side: float = 0.25       # m: handle-less cells smaller than this both ways are tiles, not fronts
+    handleless_min_seams: int = 2     # a handle-less cell cut out by this many straight seams is a front (0: never)
 
 
 def params_from_config(cfg: "HeuristicConfig") -> ImageFrontParams:  # noqa: F821 - pydantic model
@@ -42,9 +43,9 @@ def params_from_config(cfg: "HeuristicConfig") -> ImageFrontParams:  # noqa: F82
     return ImageFrontParams(
         ortho=OrthoParams(resolution=cfg.ortho_resolution, max_views=cfg.max_views, calibrate=cfg.calibrate_colour),
         cells=CellParams(seam_contrast=cfg.seam_contrast, seam_span=cfg.seam_span, seam_prominence=cfg.seam_prominence,
-                         seam_prominence_h=cfg.seam_prominence_h, handle_contrast=cfg.handle_contrast,
+                         seam_prominence_h=cfg.seam_prominence_h, seam_z=cfg.seam_z, handle_contrast=cfg.handle_contrast,
                          handle_len=tuple(cfg.handle_len), handle_thick=tuple(cfg.handle_thick)),
-        min_tile_side=cfg.min_tile_side)
+        min_tile_side=cfg.min_tile_side, handleless_min_seams=cfg.handleless_min_seams)
 
 
 @dataclass
@@ -78,9 +79,18 @@ def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = 0.03) -> np.nda
     return keep[lab]
 
 
-def cov_outline(cov: np.ndarray, px: int = 15) -> np.ndarray:
-    """The plane's outline with holes up to ``px`` closed (a handle's scanning shadow is a hole)."""
-    return cv2.morphologyEx(cov.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((px, px), np.uint8)).astype(bool)
+def cov_outline(cov: np.ndarray, px: int = 20) -> np.ndarray:
+    """The plane's outline with holes and notches up to ``px`` wide filled: a pixel is inside when
+    the plane is within ``px`` on both sides of it along a row or along a column (a handle's scanning
+    shadow is a hole, or a notch where the handle sits at the front's edge; a closing misses both once
+    the shadow is wider than the kernel)."""
+    c = cov.astype(np.uint8)
+    k = np.ones((1, px + 1), np.uint8)
+    left = cv2.dilate(c, k, anchor=(px, 0), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    right = cv2.dilate(c, k, anchor=(0, 0), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    up = cv2.dilate(c, k.T, anchor=(0, px), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    down = cv2.dilate(c, k.T, anchor=(0, 0), borderType=cv2.BORDER_CONSTANT, borderValue=0)
+    return cov.astype(bool) | (left & right).astype(bool) | (up & down).astype(bool)
 
 
 def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
@@ -111,32 +121,76 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     centroids = mesh.vertices[mesh.faces].mean(1)
     normals, _ = face_normals(mesh)
     fronts: list[Front] = []
+    gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     diffs = []
     for o in orthos:
         cov = coverage_map(o, mesh)
         o.n_views[~cov] = 0  # where the plane's own faces are not (floor, worktop edge seen at the same depth)
         diff = off_background(o, params.cells)
         diffs.append(diff)
-        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals) & cov_outline(cov))
-        clutter = (diff > params.cells.handle_contrast) & (o.n_views > 0)
+        outline = cov_outline(cov)  # handle shadows are holes in the plane, not its outline
+        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals) & outline, outline)
+        clutter = (diff > off_threshold(diff, o.n_views > 0, params.cells)) & (o.n_views > 0)
         for h in handles:  # a handle is not clutter
             clutter[h.pixels[:, 1], h.pixels[:, 0]] = False
         p = o.plane
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
-        for cell in split_cells(o, cov, handles, params.cells):
-            f = _cell_front(o, cell, cov, clutter, in_plane, rules, params, taken_faces)
+        cells = split_cells(o, cov, handles, params.cells)
+        tiled = any(max(c.c1 - c.c0, c.r1 - c.r0) * o.res < params.min_tile_side
+                    and cov[c.r0:c.r1, c.c0:c.c1].mean() >= params.cells.min_seen for c in cells)
+        for cell in cells:
+            f = _cell_front(o, cell, cov, clutter, in_plane, rules, params, None)
             if f is not None:
                 fronts.append(f)
-    # a handle-less cell is a front only beside a front with a handle (tiles and splash-backs have none)
-    fronts = [f for f in fronts if f.handle_points is not None
+                if not tiled and 0 < params.handleless_min_seams <= cell.seam_cuts:
+                    gridded.add(id(f))
+    fronts, split_mesh = _settle_with_mesh_fronts(fronts, taken_faces, mesh_fronts, mesh.n_faces)
+    # a handle-less cell is a front beside a front with a handle, or when straight seams along its whole
+    # length cut it out on ``handleless_min_seams`` sides (push-to-open fronts); tiles and splash-backs
+    # have no handles and, tiled, cells smaller than a front
+    fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded
               or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
     for f in fronts:
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else None
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
-    vetoed = [k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, params)]
+    vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, params)})
     return ImageFronts(fronts, vetoed, planes, orthos, calib)
+
+
+def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh_fronts: Sequence[Front],
+                             n_faces: int) -> tuple[list[Front], set[int]]:
+    """Image fronts beside the fronts found on the mesh. A mesh front holding two or more image fronts
+    with handles is several fronts the mesh could not tell apart (a TSDF dresser is one facet): it is
+    replaced by them. Otherwise the mesh front stands: an image front lying mostly (> 30 %) on its faces
+    is dropped, and one touching it loses those faces. Returns the kept image fronts and the indices of
+    the mesh fronts replaced."""
+    if taken is None or not taken.any():
+        return fronts, set()
+    owner = np.full(n_faces, -1, np.int64)
+    for k, mf in enumerate(mesh_fronts):
+        owner[mf.faces] = k
+    held: dict[int, int] = {}
+    for f in fronts:
+        o = owner[f.faces]
+        if f.handle_points is not None and len(o):
+            k = int(np.bincount(o + 1).argmax()) - 1
+            if k >= 0 and (o == k).mean() > 0.5:
+                held[k] = held.get(k, 0) + 1
+    split = {k for k, n in held.items() if n >= 2}
+    standing = taken.copy()
+    for k in split:
+        standing[mesh_fronts[k].faces] = False
+    kept = []
+    for f in fronts:
+        on = standing[f.faces]
+        if on.sum() > 0.3 * max(len(f.faces), 1):
+            continue
+        f.faces = f.faces[~on]
+        if len(f.faces) >= 4:
+            kept.append(f)
+    return kept, split
 
 
 def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarray], params: ImageFrontParams) -> bool:

@@ -203,5 +203,70 @@ def test_split_between_handles_ends_on_overlapping_bars() -> None:
     c = Cell(0, 0, 300, 200, [h1, h2])
     ev = np.zeros((200, 300), bool)
     ev[:, 150] = True
-    cells = _split_handles(c, ev, ev, np.ones((200, 300), bool), min_px=20)
+    cells = _split_handles(c, ev, ev, np.ones((200, 300), bool), 20, np.ones((200, 300)), CellParams())
     assert sum(len(x.handles) for x in cells) == 2 and all(x.handles for x in cells)
+
+
+def test_dip_scores_hand_computed() -> None:
+    """A flat panel (brightness 1.0) with one column at 0.9: that column dips 0.1 below its neighbours'
+    median; the noise (MAD of the dips) is 0, floored at 1e-3, so it scores 100; every other column 0.
+    A line less than half covered scores 0 whatever its brightness."""
+    from react3d_core.perception.heuristic.front_cells import _dip_scores
+
+    g = np.ones((40, 60))
+    g[:, 30] = 0.9
+    g[:, 45] = 0.5
+    cov = np.ones((40, 60), bool)
+    cov[:25, 45] = False                       # column 45: 15 of 40 pixels covered
+    z = _dip_scores(g, cov, 0, 5, CellParams())
+    assert z[30] == pytest.approx(100.0)
+    assert z[45] == 0.0 and np.count_nonzero(z) == 1
+
+
+def test_straight_seam_found_through_wood_grain() -> None:
+    """The synthetic generator's own wood grain (vertical rings, ±10 %) fused like an orthophoto (nine
+    views, each off by up to a pixel, averaged over 4 mm pixels, median) makes dark vertical lines in
+    many columns, so valley counts cannot tell a seam. A straight 2 px seam 30 % dark along the whole
+    height (what the photo renderer's crevices give) is found by its line median at column 100; the
+    same panel without the seam is not cut."""
+    import cv2
+
+    from react3d_core.synthetic.materials import WOOD, albedo_modulation
+
+    h, w, res, ss = 160, 200, 0.004, 4
+    X, Z = np.meshgrid(np.arange(w * ss) * res / ss + 0.3, 1.2 - np.arange(h * ss) * res / ss)
+    pts = np.stack([X, np.full_like(X, 2.0), Z])
+    nrm = np.broadcast_to(np.array([0.0, -1.0, 0.0])[:, None, None], pts.shape)
+    fine = albedo_modulation(pts, nrm, np.full(X.shape, WOOD))
+
+    def fused(img: np.ndarray) -> Orthophoto:
+        rng = np.random.default_rng(0)
+        views = []
+        for _ in range(9):
+            dx, dy = rng.uniform(-1, 1, 2) * ss
+            m = np.float32([[1, 0, dx], [0, 1, dy]])
+            shifted = cv2.warpAffine(img, m, (img.shape[1], img.shape[0]), borderMode=cv2.BORDER_REFLECT)
+            views.append(cv2.resize(shifted, (w, h), interpolation=cv2.INTER_AREA))
+        return _ortho(np.repeat(np.median(views, 0)[:, :, None], 3, 2), res)
+
+    cov = np.ones((h, w), bool)
+    p = CellParams()
+    assert len(split_cells(fused(fine), cov, [], p)) == 1
+    seam = fine.copy()
+    seam[:, 100 * ss:102 * ss] *= 0.7
+    cells = split_cells(fused(seam), cov, [], p)
+    assert len(cells) == 2 and abs(min(c.c1 for c in cells) - 101) <= 1
+
+
+def test_outline_fills_handle_shadow_notch() -> None:
+    """A front whose handle's scanning shadow is a notch open to its top edge (3 px wide, 3 deep):
+    the outline fills it (plane on both sides within 4 px) but adds nothing outside the front."""
+    from react3d_core.perception.heuristic.image_fronts import cov_outline
+
+    cov = np.zeros((10, 12), bool)
+    cov[2:8, 2:10] = True
+    cov[2:5, 5:8] = False
+    out = cov_outline(cov, 4)
+    expected = np.zeros((10, 12), bool)
+    expected[2:8, 2:10] = True
+    assert np.array_equal(out, expected)
