@@ -127,6 +127,13 @@ def fan_out(scenes: list[Path], out_root: str, config: dict[str, Any] | None, de
     running: dict[Any, tuple[str, int]] = {}
     rows: dict[str, dict[str, Any]] = {}
     with get_client(sync_client=True) as client:
+        from prefect.exceptions import ObjectNotFound
+
+        try:
+            client.read_deployment_by_name(deployment)
+        except ObjectNotFound:
+            raise InputError(deployment, "no such deployment on this Prefect server (PREFECT_API_URL); run "
+                                         "deployments/setup.py and `prefect deploy` first (docs/orchestration.md)") from None
         while queue or running:
             while queue and len(running) < max(1, max_in_flight):
                 name, attempt = queue.popleft()
