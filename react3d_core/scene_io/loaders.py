@@ -19,6 +19,7 @@ from ..camera import nerfstudio_scannetpp_to_c2w, opengl_to_opencv_c2w
 from ..config.frames import FrameSelectionConfig
 from ..data.frames import Frame, ImageRef, Intrinsics, SceneInput, validate_pose
 from ..errors import InputError
+from ..raster import Rasterizer
 from .depth_bin import DepthBin
 from .images import check_jpeg_complete, depth_size_problem
 from .selection import FrameSelection, choose_frames
@@ -264,7 +265,7 @@ def _load_generic(root: Path, scannetpp_world: bool | None = None) -> SceneInput
 
 def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, *,
                layout: str | None = None, scannetpp_world: bool | None = None,
-               cache_dir: str | Path | None = None, rasterizer: Callable[[Path], object] | None = None) -> SceneInput:
+               cache_dir: str | Path | None = None, rasterizer: Callable[[Path], Rasterizer] | None = None) -> SceneInput:
     """Load any supported layout (auto-detected unless ``layout`` is given), then select frames.
 
     ``cache_dir`` (DSLR only; default ``<scene>/.react3d_cache``) receives undistorted images and rendered depth.
@@ -277,10 +278,12 @@ def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, 
     chosen: list[FrameSelection] = []
 
     def sel(frames: list[Frame], mesh: Path) -> list[Frame]:
+        if selection is None:
+            return frames
         r = None
-        if selection is not None and selection.stride is None and selection.coverage_width > 0:
+        if selection.stride is None and selection.coverage_width > 0:
             r = rasterizer(mesh) if rasterizer is not None else _default_rasterizer(mesh)
-        chosen.append(choose_frames(frames, selection, r))  # type: ignore[arg-type]
+        chosen.append(choose_frames(frames, selection, r))
         return chosen[-1].frames
 
     if layout == "scannetpp_dslr":
@@ -288,7 +291,7 @@ def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, 
 
         mesh = _check_mesh(root / "scans" / "mesh_aligned_0.05.ply")
         cache = Path(cache_dir) if cache_dir else root / ".react3d_cache"
-        frames = load_dslr_frames(root, cache / "dslr", mesh, (lambda fs: sel(fs, mesh)) if selection is not None else list)
+        frames = load_dslr_frames(root, cache / "dslr", mesh, lambda fs: sel(list(fs), mesh))
         gt_dir = next((d for d in (root / "articulate3d", root.parent / "articulate3d") if d.is_dir()), None)
         return SceneInput(scene_id=root.name, root=root, mesh_path=mesh, frames=tuple(frames),
                           source_format="scannetpp_dslr", gt_dir=gt_dir,
@@ -307,8 +310,7 @@ def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, 
     return scene
 
 
-def _default_rasterizer(mesh_path: Path) -> object:
+def _default_rasterizer(mesh_path: Path) -> Rasterizer:
     from ..data.mesh import load_mesh
-    from ..raster import Rasterizer
 
     return Rasterizer(load_mesh(mesh_path))

@@ -18,6 +18,7 @@ import numpy as np
 
 from ..config.frames import FrameSelectionConfig
 from ..data.frames import Frame
+from ..raster import Rasterizer
 
 #: voxel edge (m) for counting how often a piece of surface was seen; about one low-res pixel at 2 m
 COVERAGE_VOXEL_M = 0.05
@@ -48,11 +49,11 @@ def _even_cap(items: list[Frame], cap: int | None) -> list[Frame]:
     return [items[i] for i in idx]
 
 
-def _voxel_hashes(rast: object, frame: Frame, width: int) -> np.ndarray:
+def _voxel_hashes(rast: Rasterizer, frame: Frame, width: int) -> np.ndarray:
     """Hashed voxel ids of the scan points this frame sees, from a ``width``-pixel-wide depth buffer."""
     intr = frame.intrinsics
     intr = intr.scaled(width, max(1, round(intr.height * width / intr.width)))
-    res = rast.render(intr.K, frame.c2w, intr.width, intr.height, frame.frame_id)  # type: ignore[attr-defined]
+    res = rast.render(intr.K, frame.c2w, intr.width, intr.height, frame.frame_id)
     v, u = np.nonzero(res.depth > 0)
     if u.size == 0:
         return np.zeros(0, np.int64)
@@ -65,14 +66,14 @@ def _voxel_hashes(rast: object, frame: Frame, width: int) -> np.ndarray:
     return np.unique(h & ((1 << _HASH_BITS) - 1))
 
 
-def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: object | None) -> FrameSelection:
+def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: Rasterizer | None) -> FrameSelection:
     n = len(frames)
     poses = np.stack([f.c2w for f in frames])
     use_cov = rasterizer is not None and cfg.coverage_width > 0
-    counts = np.zeros(1 << _HASH_BITS, np.int32) if use_cov else None
+    counts = np.zeros(1 << _HASH_BITS if use_cov else 0, np.int32)  # kept frames that saw each voxel (hashed)
     kept = [0]
-    if use_cov:
-        counts[_voxel_hashes(rasterizer, frames[0], cfg.coverage_width)] += 1  # type: ignore[index]
+    if rasterizer is not None and use_cov:
+        counts[_voxel_hashes(rasterizer, frames[0], cfg.coverage_width)] += 1
     last = poses[0]
     skip_motion = skip_cov = 0
     for i in range(1, n):
@@ -81,13 +82,13 @@ def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: objec
         if not moved and _rotation_deg(last[:3, :3], cur[:3, :3]) < cfg.keyframe_rotation_deg:
             skip_motion += 1
             continue
-        if use_cov:
+        if rasterizer is not None and use_cov:
             vox = _voxel_hashes(rasterizer, frames[i], cfg.coverage_width)
-            new = float(np.mean(counts[vox] < cfg.coverage_target_views)) if vox.size else 0.0  # type: ignore[index]
+            new = float(np.mean(counts[vox] < cfg.coverage_target_views)) if vox.size else 0.0
             if new < cfg.coverage_min_new:
                 skip_cov += 1
                 continue
-            counts[vox] += 1  # type: ignore[index]
+            counts[vox] += 1
         kept.append(i)
         last = cur
     cap = cfg.keyframe_cap if cfg.max_frames is None else min(cfg.keyframe_cap, cfg.max_frames)
@@ -103,9 +104,8 @@ def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: objec
     return FrameSelection(out, n, reason, skip_motion, skip_cov, len(kept) - len(out))
 
 
-def choose_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer: object | None = None) -> FrameSelection:
-    """Select frames per ``cfg``; ``rasterizer`` (a :class:`react3d_core.raster.Rasterizer` of the scan)
-    enables the coverage rule of keyframe mode."""
+def choose_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer: Rasterizer | None = None) -> FrameSelection:
+    """Select frames per ``cfg``; ``rasterizer`` (of the scan mesh) enables the coverage rule of keyframe mode."""
     frames = list(frames)
     if not frames:
         return FrameSelection([], 0, "no frames")
@@ -126,6 +126,6 @@ def choose_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer
     return FrameSelection(capped, len(frames), reason, dropped_by_cap=len(out) - len(capped))
 
 
-def select_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer: object | None = None) -> list[Frame]:
+def select_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer: Rasterizer | None = None) -> list[Frame]:
     """The frames :func:`choose_frames` keeps."""
     return choose_frames(frames, cfg, rasterizer).frames
