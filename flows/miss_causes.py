@@ -8,13 +8,21 @@ run reproduces the conversion it explains (its candidate and part counts are ret
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from react3d_core.config import PipelineConfig
+    from react3d_core.data.frames import SceneInput
+    from react3d_core.data.masks import Mask2D
+    from react3d_core.data.mesh import TriMesh
+    from react3d_core.ground_truth import GroundTruth
 
-def _gt_faces(gt) -> dict[int, np.ndarray]:  # noqa: ANN001 - GroundTruth
+
+def _gt_faces(gt: GroundTruth) -> dict[int, np.ndarray]:
     """Face ids of each movable GT part with the parts below it in the label hierarchy (handles)."""
     out = {}
     for p in gt.movable:
@@ -23,12 +31,12 @@ def _gt_faces(gt) -> dict[int, np.ndarray]:  # noqa: ANN001 - GroundTruth
     return out
 
 
-def _face_areas(mesh) -> np.ndarray:  # noqa: ANN001 - TriMesh
+def _face_areas(mesh: TriMesh) -> np.ndarray:
     t = mesh.vertices[mesh.faces]
     return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
 
 
-def masks_on_parts_2d(scene, masks, cfg) -> dict[int, int] | None:  # noqa: ANN001 - SceneInput, PackedMasks, PipelineConfig
+def masks_on_parts_2d(scene: SceneInput, masks: Mapping[str, Sequence[Mask2D]], cfg: PipelineConfig) -> dict[int, int] | None:
     """Per movable GT part, how many masks lie on it in the GT part-id images (pixels: >= ``cause_view_precision``
     of the mask on the part, >= ``cause_view_coverage`` of the part's pixels); None without such images
     (rendering GT faces of the scan instead would see what the scan sees, not what the images show)."""
