@@ -89,7 +89,13 @@ def deploy_convert_scene(source: Path, pool: str, concurrency: int = 4, env: dic
     """Deploy ``convert-scene`` from ``source`` (a folder every worker sees) to ``pool``."""
     from flows.convert_scene import convert_scene
 
-    job_env = {"PREFECT_FLOWS_HEARTBEAT_FREQUENCY": str(HEARTBEAT_SECONDS), **(env or {})}
+    from tasks import storage
+
+    job_env = {"PREFECT_FLOWS_HEARTBEAT_FREQUENCY": str(HEARTBEAT_SECONDS)}
+    store = storage.settings().store
+    if storage.is_remote(store):  # the same URL on every worker; credentials stay in the workers' env
+        job_env.update({"REACT3D_STORE": str(store), **storage.result_storage_env(store)})
+    job_env.update(env or {})
     return convert_scene.from_source(source=str(source), entrypoint="flows/convert_scene.py:convert_scene").deploy(
         name="convert-scene", work_pool_name=pool, concurrency_limit=concurrency,
         job_variables={"env": job_env}, tags=["react3d"], print_next_steps=False)
