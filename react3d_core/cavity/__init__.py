@@ -9,9 +9,10 @@
 - d_mesh: where the ray leaves the scan's bounding box;
 - d_body: the furniture's own depth, for when nothing is seen behind it (a free-standing chest whose back
   no camera saw: d_hit then reaches the room wall 2 m away and a drawer got 1.18 m of travel in a
-  0.37 m chest, issue 16). Rays cast straight up from points ever deeper behind the front hit the
-  carcass top (or the worktop) at about the same height while they are inside the furniture; the first
-  depth where the hit jumps up by ``body_jump_m`` (or vanishes) is past its back.
+  0.37 m chest, issue 16; a wall cabinet whose wall no camera saw behind it). Rays cast straight up
+  from points ever deeper behind the front hit the carcass top or worktop at about the same distance
+  while they are inside the furniture (down to a wall cabinet's bottom board when nothing is above);
+  the first depth where the hit jumps by ``body_jump_m`` (or vanishes) is past its back.
 Depths are measured from the slab's back face.
 """
 
@@ -26,7 +27,7 @@ from ..data.frames import Frame
 from ..data.mesh import TriMesh
 
 UP = np.array([0.0, 0.0, 1.0])  # world = scan frame, z up (data/frames.py conventions)
-STAGE_VERSION = "3"  # 3: d_body bounds the cavity by the furniture's own depth
+STAGE_VERSION = "4"  # 3: d_body bounds the cavity by the furniture's own depth; 4: down-rays where nothing is above
 
 
 @dataclass
@@ -96,10 +97,13 @@ def d_image(pf: PartFrame, frame: Frame | None, depth: np.ndarray | None, cfg: C
 def d_body(pf: PartFrame, cast: callable, cfg: CavityConfig, up: np.ndarray = UP) -> float:  # type: ignore[valid-type]
     """Depth behind the back face at which the furniture around the part ends (inf if not found).
 
-    Up-rays from 3 points across the part's width at depths ``body_step_m`` apart; the reference is the
-    median hit distance of the first three depths (inside the carcass); the body ends half a step
-    before the first depth whose median hit is ``body_jump_m`` higher or missing. Fronts facing up or
-    down (flaps in a worktop) have no such profile."""
+    Rays straight up from 3 points across the part's width, at depths ``body_step_m`` apart; the
+    reference is the median hit distance of the first three depths (inside the carcass: its top or the
+    worktop); the body ends half a step before the first depth whose median hit is ``body_jump_m``
+    farther or missing. Only when nothing at all is above the part (a wall cabinet whose top no camera
+    saw) are rays cast down instead, to its bottom board: below a base unit they would follow plinths
+    and toe-kicks (on a scene-synthesizer kitchen they cut two 0.69 m base cavities to 0.19 m). Fronts
+    facing up or down (flaps in a worktop) have no such profile."""
     up = np.asarray(up, float) / np.linalg.norm(up)
     if abs(float(np.dot(pf.n, up))) > 0.5:
         return np.inf
@@ -107,20 +111,20 @@ def d_body(pf: PartFrame, cast: callable, cfg: CavityConfig, up: np.ndarray = UP
     width = pf.su if side is pf.u else pf.sv
     start = max(cfg.ignore_hits_thickness_factor * pf.thickness, 0.02)
     cs = np.arange(start, cfg.max_depth_m + cfg.body_step_m, cfg.body_step_m)
+    if len(cs) < 4:
+        return np.inf
     lat = np.array([-cfg.body_lateral_factor, 0.0, cfg.body_lateral_factor]) * width
     origins = (pf.back + cs[:, None, None] * pf.n + lat[None, :, None] * side).reshape(-1, 3)
-    t = np.asarray(cast(origins, np.tile(up, (len(origins), 1))), float).reshape(len(cs), len(lat))
-    t = np.median(np.where(np.isfinite(t), t, np.inf), axis=1)
-    if len(t) < 4:
-        return np.inf
-    t0 = float(np.median(t[:3]))
-    if not np.isfinite(t0):
-        return np.inf  # nothing above the part: no carcass top to follow
-    out = np.flatnonzero(~(t <= t0 + cfg.body_jump_m))
-    out = out[out >= 3]
-    if len(out) == 0:
-        return np.inf
-    return float(cs[out[0]] - 0.5 * cfg.body_step_m)
+    for d in (up, -up):
+        t = np.asarray(cast(origins, np.tile(d, (len(origins), 1))), float).reshape(len(cs), len(lat))
+        t = np.median(np.where(np.isfinite(t), t, np.inf), axis=1)
+        t0 = float(np.median(t[:3]))
+        if not np.isfinite(t0):
+            continue  # nothing above the part: follow what is below instead
+        out = np.flatnonzero(~(t <= t0 + cfg.body_jump_m))
+        out = out[out >= 3]
+        return float(cs[out[0]] - 0.5 * cfg.body_step_m) if len(out) else np.inf
+    return np.inf
 
 
 def estimate_cavity(pf: PartFrame, cast: callable, bounds: np.ndarray, frame: Frame | None,  # type: ignore[valid-type]

@@ -82,3 +82,19 @@ def test_no_carcass_top_gives_no_body_bound() -> None:
     m.add_box([-2.0, -2.0, 2.5], [3.0, 2.6, 2.52], (200, 200, 200))
     mesh, _, _ = m.build()
     assert d_body(drawer_frame(), _Geometry(mesh).cast, CavityConfig()) == np.inf
+
+
+def test_wall_cabinet_with_an_unseen_wall_is_bounded_from_below() -> None:
+    """A wall cabinet (bottom board seen from below, top and the wall behind it never seen) over a
+    floor: up-rays find nothing, down-rays hit its bottom board inside and the floor past its back."""
+    m = MeshBuilder(edge=0.1)
+    m.add_box([0, 0, 1.4], [0.6, 0.33, 1.4 + T], (200, 200, 200))    # bottom board, 0.33 deep
+    m.add_box([-2.0, -2.0, -0.02], [3.0, 2.6, 0.0], (200, 200, 200))  # floor
+    mesh, _, _ = m.build()
+    pf = PartFrame(center=np.array([0.3, -0.011, 1.75]), u=np.array([1.0, 0.0, 0.0]), v=np.array([0.0, 0.0, 1.0]),
+                   n=np.array([0.0, 1.0, 0.0]), su=0.56, sv=0.6, thickness=0.018)
+    geo = _Geometry(mesh)
+    # down-rays hit the board while y = -0.002 + c <= 0.33 (c <= 0.332): last inside 0.316, first out 0.336
+    assert d_body(pf, geo.cast, CavityConfig()) == pytest.approx(0.326, abs=1e-9)
+    d, src, _ = estimate_cavity(pf, geo.cast, mesh.bounds(), None, None, CavityConfig())
+    assert src == "body" and d == pytest.approx(0.326, abs=1e-9)
