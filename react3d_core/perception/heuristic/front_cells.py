@@ -228,7 +228,7 @@ def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellP
     """Per line across ``axis``: how far its median brightness dips below the lines beside it (within
     ``min_px``), in noise units. A seam is a straight dark line along the whole cell, so the median over
     the line dips, while wood grain, noise and reflections wander and average out (boolean valley counts
-    saturate on strongly grained fronts). Lines less than half covered score 0."""
+    saturate on strongly grained fronts). Lines less than 30 % covered score 0."""
     cov = cov & np.isfinite(g)
     n = cov.sum(axis)
     if not n.any():
@@ -236,7 +236,7 @@ def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellP
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN lines are handled below
         prof = np.nanmedian(np.where(cov, g, np.nan), axis)
-    ok = (n >= 0.5 * n.max()) & np.isfinite(prof)
+    ok = (n >= 0.3 * n.max()) & np.isfinite(prof)
     if ok.sum() < 3:
         return np.zeros(len(n))
     prof = np.where(ok, prof, np.median(prof[ok]))

@@ -210,14 +210,14 @@ def test_split_between_handles_ends_on_overlapping_bars() -> None:
 def test_dip_scores_hand_computed() -> None:
     """A flat panel (brightness 1.0) with one column at 0.9: that column dips 0.1 below its neighbours'
     median; the noise (MAD of the dips) is 0, floored at 1e-3, so it scores 100; every other column 0.
-    A line less than half covered scores 0 whatever its brightness."""
+    A line less than 30 % covered scores 0 whatever its brightness."""
     from react3d_core.perception.heuristic.front_cells import _dip_scores
 
     g = np.ones((40, 60))
     g[:, 30] = 0.9
     g[:, 45] = 0.5
     cov = np.ones((40, 60), bool)
-    cov[:25, 45] = False                       # column 45: 15 of 40 pixels covered
+    cov[:30, 45] = False                       # column 45: 10 of 40 pixels covered
     z = _dip_scores(g, cov, 0, 5, CellParams())
     assert z[30] == pytest.approx(100.0)
     assert z[45] == 0.0 and np.count_nonzero(z) == 1
