@@ -37,7 +37,9 @@ Joint causes (matched parts; OE > ``cause_oe_deg`` or MD > ``cause_md_m``): ``ty
 ``sliding_not_flagged`` (GT slides in the front plane, the part was pulled out of it), ``obb_tilt``
 (no side of the part's box is within the threshold of the GT axis: the box is tilted by stray or missing
 faces), ``not_refined`` (a non-flat part keeps the predicted axis), ``wrong_obb_axis`` (refinement
-snapped to another side of the box), ``far_edge`` (the nearer-edge rule picked the far edge),
+snapped to another side of the box), ``far_edge`` (the nearer-edge rule picked the far edge though the
+predicted hinge line was nearer the right one), ``wrong_hinge_side`` (the prediction put the hinge on
+the other edge and the rule followed it),
 ``edge_offset`` (neither box edge is on the hinge: the part's outline is off), ``other_origin``.
 """
 
@@ -56,7 +58,7 @@ MISS_CAUSES = ("coincident_gt", "not_seen", "not_masked", "off_scan_surface", "f
                "merged_in_reseg", "resegmentation", "clipped", "duplicate_dropped", "rejected_by_validation",
                "dropped_by_dedup", "unobserved_geometry", "other")
 JOINT_CAUSES = ("type_wrong", "sliding_not_flagged", "obb_tilt", "not_refined", "wrong_obb_axis", "far_edge",
-                "edge_offset", "other_axis", "other_origin")
+                "wrong_hinge_side", "edge_offset", "other_axis", "other_origin")
 
 
 @dataclass
@@ -253,7 +255,10 @@ def joint_causes(pred: PredictedJoint, gt: Articulation, cfg: EvaluationConfig) 
         d_gt = [line_distance(e, R[:, k], gt.origin, gt_axis) for e in edges]
         chosen = int(np.argmin([np.linalg.norm(np.asarray(a.origin) - e) for e in edges]))
         if d_gt[1 - chosen] <= cfg.cause_md_m < d_gt[chosen]:
-            out.append("far_edge")
+            ini = pred.initial
+            by_pred = (None if ini is None else
+                       [line_distance(e, R[:, k], ini.origin, ini.axis) for e in edges])
+            out.append("far_edge" if by_pred is not None and by_pred[1 - chosen] < by_pred[chosen] else "wrong_hinge_side")
         elif min(d_gt) > cfg.cause_md_m:
             out.append("edge_offset")
         else:

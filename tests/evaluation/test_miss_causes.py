@@ -100,8 +100,12 @@ def _pj(jt: str, axis, origin, obb: OBB, flat: bool = True) -> PredictedJoint:  
 
 def test_joint_causes_on_hand_made_boxes() -> None:
     hinge = Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(0.0, 0.01, 0.4))  # left edge
-    # the nearer-edge rule picked the right edge (0.6 m off), the left one is on the hinge: far edge
-    assert joint_causes(_pj("revolute", (0, 0, 1), (0.6, 0.01, 0.4), _door_obb()), hinge, CFG) == ["far_edge"]
+    # the prediction put the hinge at the right edge (0.6 m off) and the rule followed it: the predictor's fault
+    assert joint_causes(_pj("revolute", (0, 0, 1), (0.6, 0.01, 0.4), _door_obb()), hinge, CFG) == ["wrong_hinge_side"]
+    # the predicted line was nearer the left edge (0.2 m vs 0.4 m) but the refined origin is on the right: the rule's
+    far = _pj("revolute", (0, 0, 1), (0.6, 0.01, 0.4), _door_obb())
+    far.initial = Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(0.2, 0.01, 0.4))
+    assert joint_causes(far, hinge, CFG) == ["far_edge"]
     # the box is 10 cm too narrow on the hinge side: neither edge is on the hinge
     narrow = OBB(center=(0.35, 0.01, 0.4), axes=((0, 0, 1), (1, 0, 0), (0, 1, 0)), extents=(0.8, 0.5, 0.02))
     assert joint_causes(_pj("revolute", (0, 0, 1), (0.1, 0.01, 0.4), narrow), hinge, CFG) == ["edge_offset"]
