@@ -30,7 +30,9 @@ from a traced run), in pipeline order; the first stage after which no output sti
 ``duplicate_dropped``      a candidate held it but the segmentation's duplicate drop removed it
 ``rejected_by_validation`` no articulation prediction matched the candidate's mask (valid_iou)
 ``dropped_by_dedup``       assembly's duplicate removal dropped it
-``unobserved_geometry``    the final part holds its seen faces, the GT also counts surface nobody saw
+``unobserved_geometry``    the final part holds the part's seen surface (area IoU), but the evaluation's
+                           vertex IoU is below the threshold: the GT counts surface no frame saw, or
+                           vertices crowd on small triangles the part left out (edges, bevels)
 ``other``                  none of the above
 
 Joint causes (matched parts; OE > ``cause_oe_deg`` or MD > ``cause_md_m``): ``type_wrong``,
