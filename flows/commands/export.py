@@ -9,7 +9,8 @@ HELP = "Export a converted scene (OUT/scene.json) to simulator formats: URDF, US
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("out", help="Output folder of a conversion (holds scene.json), or the scene.json itself.")
-    p.add_argument("--formats", default=None, help="Comma-separated formats (urdf, usd, mjcf); default: the config's export.formats.")
+    p.add_argument("--formats", default=None, help="Comma-separated formats (urdf, usd, mjcf); default: the config's export.formats. "
+                                                   "OUT/export is replaced as a whole and then holds exactly these (collisions come from the cache).")
     p.add_argument("--config", default=None, help="Pipeline config JSON; its 'export' section is used.")
     p.add_argument("--ros-package", action="store_true", help="Also write a ROS 2 description package (package:// paths).")
     p.add_argument("--texel-per-m", type=float, default=None, help="Texture budget override (texels per metre).")
