@@ -38,6 +38,8 @@ class HeuristicConfig(StageConfig):
     seam_prominence: float = Field(0.3, ge=0, le=1, description="... and this much more than the lines around it (vertical seams).")
     seam_prominence_h: float = Field(0.5, ge=0, le=1, description="The same for horizontal seams (reflections of table/shelf edges are horizontal).")
     seam_z: float = Field(15.0, ge=0, description="A straight seam: the line's median brightness dips this many noise units below the lines beside it (found through wood grain).")
+    step_contrast: float = Field(0.25, ge=0, description="A colour step along a whole line (a door leaf in a pale wall) cuts when its colour distance is at least this ...")
+    step_z: float = Field(15.0, ge=0, description="... and this many noise units of the cell's steps.")
     handle_contrast: float = Field(0.12, ge=0, description="Colour distance of handle pixels from the local background.")
     handle_len: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
     handle_thick: tuple[float, float] = Field((0.014, 0.07), description="Short side of a handle (m).")

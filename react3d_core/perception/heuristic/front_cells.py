@@ -12,6 +12,7 @@ thresholds are in metres or brightness ratios (the orthophoto is exposure-normal
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import cv2
@@ -38,6 +39,8 @@ class CellParams:
     outline_margin: float = 0.02     # m: colour blobs this close to the plane's outline are not handles
     texture_factor: float = 3.0      # handle/seam thresholds rise to this many times the plane's median response
     seam_z: float = 15.0             # a straight seam: the line's median brightness dips this many noise units below its neighbours
+    step_contrast: float = 0.25      # a colour step along a whole line (a door leaf in a pale wall): colour distance across it ...
+    step_z: float = 15.0             # ... and in noise units of the cell's steps
     max_depth: int = 6               # guillotine recursion depth
 
 
@@ -189,8 +192,9 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], p: C
     for h in handles:
         blocked_c[h.box[0]:h.box[2]] = True
         blocked_r[h.box[1]:h.box[3]] = True
-    g = np.where(o.n_views > 0, o.color.mean(-1), np.nan)  # unseen pixels carry no brightness
-    cells = _split(root, vert, horiz, coverage, p, min_px, 0, blocked_c, blocked_r, handles, g)
+    col = np.where((o.n_views > 0)[..., None], o.color, np.nan)  # unseen pixels carry no colour
+    g = col.mean(-1)
+    cells = _split(root, vert, horiz, coverage, p, min_px, 0, blocked_c, blocked_r, handles, g, col)
     for c in cells:
         c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     out: list[Cell] = []
@@ -245,20 +249,50 @@ def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellP
     return np.where(ok & (dip >= p.seam_contrast), dip / noise, 0.0)
 
 
+def _step_scores(c: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams) -> np.ndarray:
+    """Per line across ``axis``: the colour step between the ``k`` lines before and after it (median
+    colour per line, k = min_px / 2), where it is at least ``step_contrast``, in noise units. A front of
+    another colour than what surrounds it (a brown door leaf in a pale wall) has no dark seam, only a
+    step along its whole edge."""
+    seen = cov & np.isfinite(c[..., 0])
+    n = seen.sum(axis)
+    if not n.any():
+        return np.zeros(len(n))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        prof = np.stack([np.nanmedian(np.where(seen, c[..., j], np.nan), axis) for j in range(3)], 1)
+    ok = (n >= 0.3 * n.max()) & np.isfinite(prof[:, 0])
+    if ok.sum() < 3:
+        return np.zeros(len(n))
+    idx = np.arange(len(n))
+    prof = np.stack([np.interp(idx, idx[ok], prof[ok, j]) for j in range(3)], 1)
+    k = max(2, min_px // 2)
+    cs = np.vstack([np.zeros((1, 3)), np.cumsum(prof, 0)])
+    lo = np.clip(idx - k, 0, None)
+    hi = np.clip(idx + 1 + k, None, len(n))
+    before = (cs[idx] - cs[lo]) / np.maximum(idx - lo, 1)[:, None]
+    after = (cs[hi] - cs[idx + 1]) / np.maximum(hi - idx - 1, 1)[:, None]
+    step = np.linalg.norm(after - before, axis=1)
+    step[(idx - lo < k) | (hi - idx - 1 < k)] = 0.0
+    noise = max(1.4826 * float(np.median(np.abs(step[ok] - np.median(step[ok])))), 1e-3)
+    return np.where(ok & (step >= p.step_contrast), step / noise, 0.0)
+
+
 def _dip_cut(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams,
-             blocked: np.ndarray) -> tuple[int, float]:
-    """Best split line by ``_dip_scores`` (index in the cell, score), keeping ``min_px`` on each side
-    and off ``blocked`` lines."""
+             blocked: np.ndarray, scores: Callable = _dip_scores) -> tuple[int, float]:
+    """Best split line by ``scores`` (``_dip_scores`` or ``_step_scores``; index in the cell, score),
+    keeping ``min_px`` on each side and off ``blocked`` lines."""
     if cov.shape[1 - axis] <= 2 * min_px:
         return -1, 0.0
-    z = np.where(blocked, 0.0, _dip_scores(g, cov, axis, min_px, p))
+    z = np.where(blocked, 0.0, scores(g, cov, axis, min_px, p))
     inner = z[min_px:len(z) - min_px]
     i = int(np.argmax(inner))
     return i + min_px, float(inner[i])
 
 
 def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: CellParams, min_px: int,
-           depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray) -> list[Cell]:
+           depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray,
+           col: np.ndarray) -> list[Cell]:
     """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at the most
     prominent seam by valley counts. Inside a cell holding handles, a horizontal cut must leave a handle
     on both sides (glossy fronts reflect horizontal table and shelf edges at a constant height; a drawer
@@ -271,7 +305,12 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
     sc_v = sc_v if sc_v >= p.seam_z else 0.0
     sc_h = sc_h if sc_h >= p.seam_z else 0.0
     straight = int(max(sc_v, sc_h) > 0.0)
-    if not straight:
+    if not straight:  # a colour step along the whole cell (a front of another colour than its surround)
+        cv_, sc_v = _dip_cut(col[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1], _step_scores)
+        ch_, sc_h = _dip_cut(col[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1], _step_scores)
+        sc_v = sc_v if sc_v >= p.step_z else 0.0
+        sc_h = sc_h if sc_h >= p.step_z else 0.0
+    if max(sc_v, sc_h) == 0.0:
         cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])
         ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
         sc_v = sc_v if sc_v >= p.seam_prominence else 0.0
@@ -290,8 +329,8 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
     else:
         a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=n, seam_cuts=k)
         b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=n, seam_cuts=k)
-    return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g)
-            + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g))
+    return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g, col)
+            + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g, col))
 
 
 def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: CellParams) -> int:

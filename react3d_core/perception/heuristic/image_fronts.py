@@ -43,7 +43,8 @@ def params_from_config(cfg: "HeuristicConfig") -> ImageFrontParams:  # noqa: F82
     return ImageFrontParams(
         ortho=OrthoParams(resolution=cfg.ortho_resolution, max_views=cfg.max_views, calibrate=cfg.calibrate_colour),
         cells=CellParams(seam_contrast=cfg.seam_contrast, seam_span=cfg.seam_span, seam_prominence=cfg.seam_prominence,
-                         seam_prominence_h=cfg.seam_prominence_h, seam_z=cfg.seam_z, handle_contrast=cfg.handle_contrast,
+                         seam_prominence_h=cfg.seam_prominence_h, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
+                         step_z=cfg.step_z, handle_contrast=cfg.handle_contrast,
                          handle_len=tuple(cfg.handle_len), handle_thick=tuple(cfg.handle_thick)),
         min_tile_side=cfg.min_tile_side, handleless_min_seams=cfg.handleless_min_seams)
 

@@ -270,3 +270,21 @@ def test_outline_fills_handle_shadow_notch() -> None:
     expected = np.zeros((10, 12), bool)
     expected[2:8, 2:10] = True
     assert np.array_equal(out, expected)
+
+
+def test_colour_step_cuts_a_door_leaf_out_of_a_wall() -> None:
+    """A brown door leaf (0.9 m) in a pale wall, no dark seam at its edges, a lever handle: the cells are
+    cut at the two colour steps, so the leaf is one cell holding the handle; a plain wall is not cut."""
+    h, w = 420, 500                            # 5 mm px: 2.1 m x 2.5 m
+    rng = np.random.default_rng(1)
+    wall = np.array([1.1, 1.15, 1.05], np.float32)
+    img = np.tile(wall, (h, w, 1)) + rng.normal(0, 0.01, (h, w, 3)).astype(np.float32)
+    assert len(split_cells(_ortho(img), np.ones((h, w), bool), [], CellParams())) == 1
+    img[:, 160:340] = np.array([0.55, 0.4, 0.3], np.float32) + rng.normal(0, 0.01, (h, 180, 3)).astype(np.float32)
+    img[200:206, 300:330] = 1.6                # lever handle near the leaf's right edge
+    o = _ortho(img)
+    cov = np.ones((h, w), bool)
+    handles = find_handles(o, cov, CellParams())
+    cells = split_cells(o, cov, handles, CellParams())
+    leaf = [c for c in cells if c.handles]
+    assert len(leaf) == 1 and abs(leaf[0].c0 - 160) <= 2 and abs(leaf[0].c1 - 340) <= 2
