@@ -61,7 +61,7 @@ def convert(scene: str, out: Path, env: dict[str, str], extra: list[str]) -> dic
     row["stage_s"] = round(timings.get("total", 0.0), 2)
     row["fixed_s"] = round(wall - row["stage_s"], 2)
     row["timings"] = {k: round(v, 2) for k, v in timings.items()}
-    row["temporary_note"] = "temporary Prefect server" in p.stderr
+    row["temporary_note"] = "temporary Prefect server" in p.stdout
     return row
 
 

@@ -47,7 +47,9 @@ def _popen(args: Any, **kwargs: Any) -> subprocess.Popen[Any]:
     if isinstance(args, list) and args[1:3] == ["-m", "uvicorn"]:
         from tasks.prefect_env import TEMPORARY_NOTE
 
-        print(TEMPORARY_NOTE, file=sys.stderr, flush=True)  # the one line saying where the seconds go
+        # the one line saying where the seconds go; stdout, beside the progress bar: stderr is for errors
+        # only (a failed command prints exactly one line there)
+        print(TEMPORARY_NOTE, flush=True)
         args = [args[0], "-m", "flows.server_watchdog", str(os.getpid()), *args[3:]]
         env = dict(kwargs.get("env") or os.environ)
         root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
