@@ -108,7 +108,7 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
         parts.append(articulate_candidate(scene, mesh, cand, {f: p for f, p in res["predictions"].items() if f in views},
                                           cfg, rasterizer=rast))
     valid = [p for p in parts if p is not None]
-    kept_ids = {p.candidate_id for p in remove_duplicates(valid, cfg.dedup)}
+    kept_ids = {p.candidate_id for p in remove_duplicates(valid, cfg.dedup, mesh.vertices)}
     # every frame once more at the fusion's working size: faces any frame sees, faces under each mask as predicted
     seen: list[np.ndarray] = []
     sets: dict[str, list[np.ndarray]] = {"raw": [], "filled": [], "lifted": []}

@@ -110,7 +110,7 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
     from ..scene_io.images import frame_depth
 
     out = Path(out_dir)
-    parts = remove_duplicates(list(parts), config.dedup)
+    parts = remove_duplicates(list(parts), config.dedup, mesh.vertices)
     geo = _Geometry(mesh)
     bounds = mesh.bounds()
     frames = {f.frame_id: f for f in scene.frames}

@@ -45,6 +45,8 @@ class DedupConfig(StageConfig):
     cover_iou: float = Field(0.8, ge=0, le=1, description="Stage 2: remove a part whose candidates' union reaches this IoU.")
     max_candidates: int = Field(16, ge=1, description="Stage 2 bound: consider at most this many candidates per part.")
     tau_contained: float = Field(0.7, ge=0, le=1, description="Stage 3: remove a part with this share of its vertices inside one larger kept part (a fragment).")
+    fragment_share: float = Field(0.25, ge=0, le=1, description="Stage 4: a part at most this share of a larger kept part's size (vertices) ...")
+    footprint_margin_m: float = Field(0.01, ge=0, description="... with tau_contained of its points inside that part's box grown by this (m) is a sliver of it.")
 
 
 class AssemblyConfig(StageConfig):

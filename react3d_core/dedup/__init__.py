@@ -8,6 +8,10 @@ is O(n * k). Overlaps come from one sparse incidence product, not Python pairs.
 Stage 3 (ours): a fragment — a part with >= tau_contained of its vertices inside one larger kept part —
 is removed. Distinct physical parts share at most boundary vertices, so such a part is a piece of the
 larger one (a frame or a panel of a frame-and-panel door that fusion also proposed on its own).
+Stage 4 (ours): a sliver — a part with at most ``fragment_share`` of a larger kept part's vertices and
+>= tau_contained of its points inside that part's box (grown by ``footprint_margin_m``) — is removed.
+Fusion sometimes splits a corner off a front (seen occluded in some views); the corner's vertices are
+not the larger part's, so stage 3 misses it, but it lies in the larger part's own slab.
 """
 
 from __future__ import annotations
@@ -19,8 +23,9 @@ import numpy as np
 from scipy.sparse import csr_matrix
 
 from ..config import DedupConfig
+from ..data.parts import OBB
 
-STAGE_VERSION = "2"  # 2: stage 3 removes fragments
+STAGE_VERSION = "3"  # 2: stage 3 removes fragments; 3: stage 4 removes slivers inside a larger part's box
 T = TypeVar("T")
 
 
@@ -36,8 +41,10 @@ def overlap_matrix(sets: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
     return inter, np.array([len(s) for s in sets], float)
 
 
-def dedup_indices(sets: Sequence[np.ndarray], cfg: DedupConfig) -> list[int]:
-    """Indices (into ``sets``) of the parts kept, in their original order."""
+def dedup_indices(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence[np.ndarray] | None = None,
+                  boxes: Sequence[OBB] | None = None) -> list[int]:
+    """Indices (into ``sets``) of the parts kept, in their original order. Stage 4 needs each part's
+    ``points`` and ``boxes``; without them it is skipped."""
     n = len(sets)
     if n == 0:
         return []
@@ -75,9 +82,22 @@ def dedup_indices(sets: Sequence[np.ndarray], cfg: DedupConfig) -> list[int]:
         inside = alive & (size > size[i]) & (contained[i] >= cfg.tau_contained)
         if alive[i] and inside.any():
             alive[i] = False
+    if points is not None and boxes is not None:
+        for i in order[::-1]:  # stage 4, smaller first, against larger kept parts
+            if not alive[i] or not len(points[i]):
+                continue
+            for j in np.flatnonzero(alive & (size * cfg.fragment_share >= size[i])):
+                if j != i and boxes[j].contains(points[i], cfg.footprint_margin_m).mean() >= cfg.tau_contained:
+                    alive[i] = False
+                    break
     return [int(i) for i in np.flatnonzero(alive)]
 
 
-def remove_duplicates(parts: Sequence[T], cfg: DedupConfig) -> list[T]:
-    """Parts (anything with ``vertex_ids``) without duplicates."""
-    return [parts[i] for i in dedup_indices([p.vertex_ids for p in parts], cfg)]  # type: ignore[attr-defined]
+def remove_duplicates(parts: Sequence[T], cfg: DedupConfig, vertices: np.ndarray | None = None) -> list[T]:
+    """Parts (anything with ``vertex_ids``; with ``obb`` too for stage 4) without duplicates;
+    ``vertices`` (the scan's) enable stage 4."""
+    sets = [p.vertex_ids for p in parts]  # type: ignore[attr-defined]
+    if vertices is None or not all(getattr(p, "obb", None) is not None for p in parts):
+        return [parts[i] for i in dedup_indices(sets, cfg)]
+    pts = [vertices[np.asarray(v, np.int64)] for v in sets]
+    return [parts[i] for i in dedup_indices(sets, cfg, pts, [p.obb for p in parts])]  # type: ignore[attr-defined]

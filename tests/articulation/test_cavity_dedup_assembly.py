@@ -82,6 +82,29 @@ def test_dedup_stage3_removes_fragments_keeps_neighbours() -> None:
     assert dedup_indices([door, panel, sliver, neighbour], DedupConfig(tau_contained=0.2)) == [0, 3]
 
 
+def test_dedup_stage4_removes_a_sliver_inside_a_larger_parts_box() -> None:
+    """A door (0.5 x 0.7 m front, 2 cm thick; 400 vertices) and a corner sliver fusion split off it
+    (vertices of its own, 0.1 x 0.25 m, in the door's slab): the sliver is removed. The same sliver
+    5 cm in front of the door (outside the box + 1 cm) stays; a neighbouring door of the same size
+    beside it stays (not a sliver: more than a quarter of the door's size); without points or boxes
+    stage 4 is skipped."""
+    from react3d_core.data.parts import OBB
+
+    rng = np.random.default_rng(0)
+    door_pts = np.c_[rng.uniform(0, 0.5, 400), rng.uniform(-0.01, 0.01, 400), rng.uniform(0, 0.7, 400)]
+    door_box = OBB(center=(0.25, 0.0, 0.35), axes=((0, 0, 1), (1, 0, 0), (0, 1, 0)), extents=(0.7, 0.5, 0.02))
+    sliver_pts = np.c_[rng.uniform(0.38, 0.48, 30), rng.uniform(-0.01, 0.01, 30), rng.uniform(0.02, 0.27, 30)]
+    sliver_box = OBB(center=(0.43, 0.0, 0.145), axes=((0, 0, 1), (1, 0, 0), (0, 1, 0)), extents=(0.25, 0.1, 0.02))
+    nb_pts = door_pts + [0.52, 0, 0]
+    nb_box = OBB(center=(0.77, 0.0, 0.35), axes=((0, 0, 1), (1, 0, 0), (0, 1, 0)), extents=(0.7, 0.5, 0.02))
+    sets = [np.arange(400), np.arange(400, 430), np.arange(430, 830)]
+    cfg = DedupConfig()
+    assert dedup_indices(sets, cfg, [door_pts, sliver_pts, nb_pts], [door_box, sliver_box, nb_box]) == [0, 2]
+    proud = sliver_pts + [0, -0.05, 0]
+    assert dedup_indices(sets, cfg, [door_pts, proud, nb_pts], [door_box, sliver_box, nb_box]) == [0, 1, 2]
+    assert dedup_indices(sets, cfg) == [0, 1, 2]
+
+
 def test_dedup_is_bounded_on_many_overlapping_candidates() -> None:
     import time
 
