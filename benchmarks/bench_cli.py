@@ -22,11 +22,14 @@ import statistics
 import subprocess
 import sys
 import time
-import urllib.request
 from pathlib import Path
 from typing import Any
 
+from _workdir import bench_workdir
+
 REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+from tasks.prefect_env import server_reachable  # noqa: E402
 
 
 def _env(work: Path, api: str | None) -> dict[str, str]:
@@ -36,14 +39,6 @@ def _env(work: Path, api: str | None) -> dict[str, str]:
     if api:
         env["PREFECT_API_URL"] = api
     return env
-
-
-def _healthy(api: str) -> bool:
-    try:
-        with urllib.request.urlopen(api + "/health", timeout=1) as r:
-            return r.status == 200
-    except OSError:
-        return False
 
 
 def convert(scene: str, out: Path, env: dict[str, str], extra: list[str]) -> dict[str, Any]:
@@ -75,8 +70,7 @@ def main() -> int:
     ap.add_argument("--no-temporary", action="store_true", help="Skip the runs with the temporary server.")
     a = ap.parse_args()
     extra = a.args.split()
-    shutil.rmtree(a.work, ignore_errors=True)
-    a.work.mkdir(parents=True)
+    bench_workdir(a.work, fresh=True)
     api = f"http://127.0.0.1:{a.port}/api"
     load = os.getloadavg()
     server = subprocess.Popen([sys.executable, "-m", "flows.cli", "server", "--port", str(a.port)], env=_env(a.work, None),
@@ -84,7 +78,7 @@ def main() -> int:
     result: dict[str, Any] = {"scene": a.scene, "args": extra, "cpus": os.cpu_count(), "load_before": load}
     try:
         t = time.perf_counter()
-        while not _healthy(api):
+        while not server_reachable(api, timeout=1):
             if server.poll() is not None or time.perf_counter() - t > 180:
                 raise SystemExit("react3d server did not come up")
             time.sleep(0.5)

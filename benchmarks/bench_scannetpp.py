@@ -29,6 +29,7 @@ from typing import Any
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 sys.path.insert(0, str(REPO / "benchmarks"))
+from _workdir import bench_workdir  # noqa: E402
 
 
 def child(scene: str, out: str, config: dict[str, Any], report: str) -> None:
@@ -119,7 +120,7 @@ def main() -> int:
         prefect_env.configure()
         child(a.child[0], a.child[1], json.loads(a.child[2]), a.child[3])
         return 0
-    a.work.mkdir(parents=True, exist_ok=True)
+    bench_workdir(a.work)  # keeps the generated scene between runs
     scene = a.work / f"kitchen_s{a.seed}_f{a.frames}_{a.faces // 1000}k"
     t = time.perf_counter()
     n_faces = make_scene(scene, a.frames, a.faces, a.seed)

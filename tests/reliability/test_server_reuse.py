@@ -14,6 +14,8 @@ import time
 import urllib.request
 from pathlib import Path
 
+from tasks.prefect_env import server_reachable
+
 from .conftest import REPO, end_group, first_line, isolated_env, run_cli
 
 FAST = ["--perception", "oracle", "--formats", "none", "--stride", "2"]
@@ -24,14 +26,6 @@ def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return int(s.getsockname()[1])
-
-
-def _healthy(api: str) -> bool:
-    try:
-        with urllib.request.urlopen(api + "/health", timeout=1) as r:
-            return r.status == 200
-    except OSError:
-        return False
 
 
 def test_unreachable_api_url_is_one_line_before_anything_runs(scan: Path, tmp_path: Path) -> None:
@@ -55,7 +49,7 @@ def test_running_server_is_reused_and_temporary_one_is_announced(scan: Path, tmp
                               text=True, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
     try:
         t = time.perf_counter()
-        while not _healthy(api):
+        while not server_reachable(api, timeout=1):
             assert server.poll() is None, server.stdout.read() if server.stdout else ""
             assert time.perf_counter() - t < 240, "react3d server did not answer"
             time.sleep(0.5)
