@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..camera import unproject
 from ..config.frames import FrameSelectionConfig
 from ..data.frames import Frame
 from ..raster import Rasterizer
@@ -54,13 +55,9 @@ def _voxel_hashes(rast: Rasterizer, frame: Frame, width: int) -> np.ndarray:
     intr = frame.intrinsics
     intr = intr.scaled(width, max(1, round(intr.height * width / intr.width)))
     res = rast.render(intr.K, frame.c2w, intr.width, intr.height, frame.frame_id)
-    v, u = np.nonzero(res.depth > 0)
-    if u.size == 0:
+    pts = unproject(res.depth, intr.K, frame.c2w)[res.depth > 0]
+    if not len(pts):
         return np.zeros(0, np.int64)
-    z = res.depth[v, u].astype(np.float64)
-    cam = np.stack([(u - intr.cx) / intr.fx * z, (v - intr.cy) / intr.fy * z, z], 1)
-    c2w = frame.c2w
-    pts = cam @ c2w[:3, :3].T + c2w[:3, 3]
     ijk = np.floor(pts / COVERAGE_VOXEL_M).astype(np.int64)
     h = (ijk[:, 0] * 73856093) ^ (ijk[:, 1] * 19349663) ^ (ijk[:, 2] * 83492791)
     return np.unique(h & ((1 << _HASH_BITS) - 1))
@@ -72,7 +69,7 @@ def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: Raste
     use_cov = rasterizer is not None and cfg.coverage_width > 0
     counts = np.zeros(1 << _HASH_BITS if use_cov else 0, np.int32)  # kept frames that saw each voxel (hashed)
     kept = [0]
-    if rasterizer is not None and use_cov:
+    if use_cov:
         counts[_voxel_hashes(rasterizer, frames[0], cfg.coverage_width)] += 1
     last = poses[0]
     skip_motion = skip_cov = 0
@@ -82,7 +79,7 @@ def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: Raste
         if not moved and _rotation_deg(last[:3, :3], cur[:3, :3]) < cfg.keyframe_rotation_deg:
             skip_motion += 1
             continue
-        if rasterizer is not None and use_cov:
+        if use_cov:
             vox = _voxel_hashes(rasterizer, frames[i], cfg.coverage_width)
             new = float(np.mean(counts[vox] < cfg.coverage_target_views)) if vox.size else 0.0
             if new < cfg.coverage_min_new:

@@ -28,9 +28,10 @@ class SlidingRules:
     min_parallel: float = 0.97     # |cos| between the fronts' normals
 
 
-def _u_range(g: Front, u: np.ndarray) -> tuple[float, float]:
-    c = float(g.center @ u)
-    return c - g.w / 2, c + g.w / 2
+def _u_overlap(f: Front, g: Front) -> float:
+    """How far ``g``'s outline overlaps ``f``'s along ``f``'s horizontal axis (< 0: the gap between them)."""
+    c = float(g.center @ f.u)
+    return min(c + g.w / 2, f.extent_u[1]) - max(c - g.w / 2, f.extent_u[0])
 
 
 def sliding_partner(f: Front, fronts: list[Front], r: SlidingRules) -> Front | None:
@@ -46,8 +47,7 @@ def sliding_partner(f: Front, fronts: list[Front], r: SlidingRules) -> Front | N
         hv = min(g.extent_v[1], f.extent_v[1]) - max(g.extent_v[0], f.extent_v[0])
         if hv < r.min_height_overlap * min(f.h, g.h) or abs(f.h - g.h) > (1 - r.min_height_overlap) * max(f.h, g.h):
             continue
-        gu = _u_range(g, f.u)
-        ov = min(gu[1], f.extent_u[1]) - max(gu[0], f.extent_u[0])  # > 0: overlap, < 0: gap
+        ov = _u_overlap(f, g)
         if not (-r.max_gap <= ov <= min(r.max_overlap, 0.5 * min(f.w, g.w))):
             continue
         if ov > best_ov:
@@ -69,8 +69,7 @@ def mark_sliding(fronts: list[Front], rules: SlidingRules = SlidingRules()) -> i
         centre = np.array([centre[0], centre[1], 0.5 * sum(f.extent_v)])
         f.kind = "sliding"
         f.articulation = Articulation(joint_type="prismatic", axis=towards * f.u, origin=centre, lower=0.0,
-                                      upper=max(0.05, f.w - max(0.0, min(_u_range(g, f.u)[1], f.extent_u[1])
-                                                                   - max(_u_range(g, f.u)[0], f.extent_u[0]))),
+                                      upper=max(0.05, f.w - max(0.0, _u_overlap(f, g))),
                                       limit_source="heuristic")
         n += 1
     return n
