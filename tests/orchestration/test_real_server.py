@@ -7,11 +7,11 @@ import os
 import socket
 import subprocess
 import sys
-import time
-import urllib.request
 from pathlib import Path
 
 import pytest
+
+from deployments.local_cluster import wait_http
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.slow
@@ -21,18 +21,6 @@ def _free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
-
-
-def _wait_http(url: str, timeout: float) -> None:
-    t0 = time.time()
-    while time.time() - t0 < timeout:
-        try:
-            with urllib.request.urlopen(url, timeout=2) as r:
-                if r.status == 200:
-                    return
-        except OSError:
-            time.sleep(1)
-    raise TimeoutError(url)
 
 
 def test_deploy_and_run_convert_dataset(synthetic_scene, tmp_path: Path) -> None:  # noqa: ANN001
@@ -50,7 +38,7 @@ def test_deploy_and_run_convert_dataset(synthetic_scene, tmp_path: Path) -> None
                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     worker = None
     try:
-        _wait_http(f"{api}/health", 180)
+        wait_http(f"{api}/health", 180)
         subprocess.run([sys.executable, "-m", "prefect", "work-pool", "create", "react3d-test", "--type", "process"],
                        env=env, check=True, capture_output=True, cwd=ROOT)
         deploy = (
