@@ -93,7 +93,7 @@ def run_one(scene: str, cache: str, n: int, decimate: bool, out: mp.Queue) -> No
     from react3d_core.config import PipelineConfig
     from react3d_core.data import load_mesh
     from react3d_core.fusion import segment_parts
-    from react3d_core.fusion.quality import segmentation_quality
+    from react3d_core.metrics.segmentation_quality import segmentation_quality
     from react3d_core.ground_truth import read_articulate3d
     from react3d_core.perception.oracle import make_oracle
     from react3d_core.raster import Rasterizer

@@ -12,7 +12,7 @@ from http.server import SimpleHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 
 from react3d_core.data import InteractiveScene
-from react3d_core.report import build_viewer_html, scene_payload
+from react3d_core.viewer import build_viewer_html, scene_payload
 
 
 class _Handler(SimpleHTTPRequestHandler):

@@ -36,7 +36,7 @@ def evaluate_body(manifest_path: str, gt_dir: str, config: dict[str, Any]) -> di
 
 
 def report_body(manifest_path: str, scene_path: str, frames_cfg: dict[str, Any], metrics: dict[str, Any] | None) -> str:
-    from react3d_core.report import write_report
+    from react3d_core.viewer import write_report
 
     per_tau = None
     if metrics:

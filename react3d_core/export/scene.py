@@ -37,7 +37,7 @@ def _write_urdf(model: SceneModel, folder: Path, files: dict[str, LinkFiles], co
 
     urdf = write_urdf(model, files, folder, config)
     if config.ros_launch:
-        from ..report.ros_launch import write_ros_launch
+        from .ros_launch import write_ros_launch
 
         write_ros_launch(urdf)
     if config.ros_package:  # a ROS package must be self-contained: its own copy of the meshes

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from react3d_core.articulation.limits import set_limits
-from react3d_core.assembly import _Geometry
+from react3d_core.assembly.scene import _Geometry
 from react3d_core.cavity import PartFrame, d_body, d_hit, estimate_cavity
 from react3d_core.config import CavityConfig, LimitConfig
 from react3d_core.data.parts import Articulation

@@ -9,7 +9,8 @@ import pytest
 
 from react3d_core.articulation.limits import revolute_limit, set_limits
 from react3d_core.articulation.types import ArticulatedPart
-from react3d_core.assembly import _Geometry, carve_background
+from react3d_core.assembly import carve_background
+from react3d_core.assembly.scene import _Geometry
 from react3d_core.cavity import PartFrame, base_mesh, d_hit, d_mesh, estimate_cavity
 from react3d_core.config import CavityConfig, DedupConfig, LimitConfig
 from react3d_core.data.parts import OBB, Articulation

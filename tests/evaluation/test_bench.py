@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flows.commands.bench import SETS_DIR, load_spec, print_table, run_bench, run_isolated
+from benchmarks.runner import SETS_DIR, load_spec, print_table, run_bench, run_isolated
 from react3d_core.data.mesh import TriMesh, load_mesh, save_mesh
 from react3d_core.errors import InputError
 

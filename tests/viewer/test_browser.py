@@ -73,7 +73,7 @@ def test_viewer_slider_moves_one_part(browser, toy_scene):
 
 
 def test_report_from_disk_slider_moves_one_part(browser, toy_scene, tmp_path: Path):
-    from react3d_core.report import write_report
+    from react3d_core.viewer import write_report
 
     report = write_report(toy_scene, tmp_path / "report.html")
     page = browser.new_page(viewport={"width": 1200, "height": 800})

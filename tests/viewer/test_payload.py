@@ -9,9 +9,9 @@ import re
 import numpy as np
 
 from react3d_core.data import TriMesh
-from react3d_core.report import scene_payload, write_report
-from react3d_core.report.payload import decimate, vertex_normals
-from react3d_core.report.thumbnails import thumbnail
+from react3d_core.viewer import scene_payload, write_report
+from react3d_core.viewer.payload import decimate, vertex_normals
+from react3d_core.viewer.thumbnails import thumbnail
 
 
 def test_payload_round_trips_arrays(toy_scene):

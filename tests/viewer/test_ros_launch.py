@@ -3,7 +3,7 @@
 import ast
 import xml.etree.ElementTree as ET
 
-from react3d_core.report.ros_launch import write_ros_launch
+from react3d_core.export.ros_launch import write_ros_launch
 
 
 def test_launch_files(tmp_path):

@@ -64,7 +64,7 @@ def _click_every_part_and_check(page, errors: list[str]) -> None:  # noqa: ANN00
 
 
 def test_report_shows_hostile_names_as_text(hostile_scene: Path, browser) -> None:  # noqa: ANN001
-    from react3d_core.report import write_report
+    from react3d_core.viewer import write_report
 
     report = write_report(hostile_scene, thumbnails=False)
     page, errors = _open(browser, report.as_uri())
@@ -88,7 +88,7 @@ def test_view_server_shows_hostile_names_as_text(hostile_scene: Path, browser) -
 
 def test_csp_blocks_script_the_page_did_not_ship(hostile_scene: Path, browser) -> None:  # noqa: ANN001
     """Second line of defence: markup injected by any future bug may not run inline handlers or scripts."""
-    from react3d_core.report import write_report
+    from react3d_core.viewer import write_report
 
     report = write_report(hostile_scene, thumbnails=False)
     page, _ = _open(browser, report.as_uri())

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from tests.perception.heuristic.bench_masks import gt_openable_masks, match
+from benchmarks.bench_masks import gt_openable_masks, match
 
 
 def test_match_one_to_one_hand_computed() -> None:

@@ -1,6 +1,6 @@
 """2D quality of the heuristic backend against GT part-id images, per frame (no fusion needed).
 
-Usage: ``python3 tests/perception/heuristic/bench_masks.py --seeds 0-9 [--frames 40] [--every 4] [--json F]``
+Usage: ``python3 benchmarks/bench_masks.py --seeds 0-9 [--frames 40] [--every 4] [--json F]``
 (seeds 0-9 tune, 100+ are held apart). A GT openable part is its part-id pixels plus its handle's; it
 counts when >= ``--min-px`` pixels are visible. Predicted masks are matched one-to-one by IoU >= 0.5
 (Hungarian on IoU); precision/recall/F1 are summed over frames; joint-type accuracy is over matches.
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from react3d_core.config import PerceptionConfig  # noqa: E402
 from react3d_core.perception.heuristic import make_heuristic  # noqa: E402

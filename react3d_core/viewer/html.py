@@ -60,7 +60,7 @@ _APP = """
 
 
 def _viewer_js() -> str:
-    return resources.files("react3d_core.report").joinpath("assets/viewer.js").read_text(encoding="utf-8")
+    return resources.files("react3d_core.viewer").joinpath("assets/viewer.js").read_text(encoding="utf-8")
 
 
 def _json_for_script(obj: Any) -> str:

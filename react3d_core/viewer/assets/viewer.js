@@ -1,5 +1,5 @@
 // REACT3D scene viewer: plain WebGL2, no dependencies, so one HTML file works offline.
-// Reads window.REACT3D_SCENE (built by react3d_core.report.payload.scene_payload).
+// Reads window.REACT3D_SCENE (built by react3d_core.viewer.payload.scene_payload).
 (function () {
   "use strict";
   const P = window.REACT3D_SCENE;
