@@ -17,25 +17,25 @@ from .articulation import ArticulationConfig, AssemblyConfig, CavityConfig, Dedu
 from .evaluation import EvaluationConfig
 from .export import ExportConfig
 from .frames import FrameSelectionConfig
-from .perception import HeuristicConfig, OracleNoiseConfig, PerceptionConfig
+from .perception import FrontRulesConfig, HeuristicConfig, OracleNoiseConfig, PerceptionConfig
 from .segmentation import ClipConfig, FusionConfig, TopKConfig
 
 
 class PipelineConfig(StageConfig):
     """All stages' settings."""
 
-    frames: FrameSelectionConfig = Field(default_factory=FrameSelectionConfig)
-    perception: PerceptionConfig = Field(default_factory=PerceptionConfig)
-    fusion: FusionConfig = Field(default_factory=FusionConfig)
-    topk: TopKConfig = Field(default_factory=TopKConfig)
-    clip: ClipConfig = Field(default_factory=ClipConfig)
-    articulation: ArticulationConfig = Field(default_factory=ArticulationConfig)
-    limits: LimitConfig = Field(default_factory=LimitConfig)
-    cavity: CavityConfig = Field(default_factory=CavityConfig)
-    dedup: DedupConfig = Field(default_factory=DedupConfig)
-    assembly: AssemblyConfig = Field(default_factory=AssemblyConfig)
-    export: ExportConfig = Field(default_factory=ExportConfig)
-    evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig)
+    frames: FrameSelectionConfig = Field(default_factory=FrameSelectionConfig, description="Which frames of a capture are used.")
+    perception: PerceptionConfig = Field(default_factory=PerceptionConfig, description="Perception backend and its thresholds.")
+    fusion: FusionConfig = Field(default_factory=FusionConfig, description="Multi-view 2D->3D fusion into part proposals.")
+    topk: TopKConfig = Field(default_factory=TopKConfig, description="Best views per proposal.")
+    clip: ClipConfig = Field(default_factory=ClipConfig, description="Clipping segmented meshes to the movable slab.")
+    articulation: ArticulationConfig = Field(default_factory=ArticulationConfig, description="Candidate validation and joint refinement.")
+    limits: LimitConfig = Field(default_factory=LimitConfig, description="Motion limits.")
+    cavity: CavityConfig = Field(default_factory=CavityConfig, description="Hidden geometry behind movable parts.")
+    dedup: DedupConfig = Field(default_factory=DedupConfig, description="Duplicate part removal.")
+    assembly: AssemblyConfig = Field(default_factory=AssemblyConfig, description="Carving the background.")
+    export: ExportConfig = Field(default_factory=ExportConfig, description="What the exporters write.")
+    evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig, description="Evaluation protocol thresholds.")
 
     def with_overrides(self, overrides: dict) -> "PipelineConfig":
         """Return a copy with nested overrides, e.g. ``{"perception": {"backend": "oracle"}}``."""
@@ -79,6 +79,7 @@ __all__ = [
     "EvaluationConfig",
     "ExportConfig",
     "FrameSelectionConfig",
+    "FrontRulesConfig",
     "FusionConfig",
     "HeuristicConfig",
     "LimitConfig",

@@ -26,9 +26,43 @@ class OracleNoiseConfig(StageConfig):
     seed: int = Field(0, description="Seed of the oracle's noise.")
 
 
-class HeuristicConfig(StageConfig):
-    """The weight-free heuristic's image path: fronts found in the colour frames (seams, handles)."""
+class FrontRulesConfig(StageConfig):
+    """The heuristic's front rules on the scan mesh (perception/heuristic/fronts.py): which planar
+    facets are openable fronts, their handles and frames, and the joint guessed from shape and handle."""
 
+    min_w: float = Field(0.12, gt=0, description="Narrowest front (m).")
+    max_w: float = Field(1.3, gt=0, description="Widest front (m).")
+    min_h: float = Field(0.1, gt=0, description="Lowest front (m).")
+    max_h: float = Field(2.3, gt=0, description="Tallest front (m).")
+    max_tilt: float = Field(0.25, ge=0, le=1, description="A front is vertical: |n_z| of its normal at most this (also bounds the image path's planes).")
+    min_fill: float = Field(0.8, ge=0, le=1, description="A front's facet fills at least this share of its bounding rectangle.")
+    handle_max_area: float = Field(0.03, gt=0, description="Largest handle facet (m^2); also the largest rim/bevel facet added to a front.")
+    handle_depth: tuple[float, float] = Field((0.002, 0.09), description="Handle facets stand this far in front of the front's plane (min, max; m).")
+    drawer_max_h: float = Field(0.45, gt=0, description="Drawers are at most this tall (m): deep drawers reach ~0.45 m, oven/dishwasher doors are >= 0.5 m.")
+    flap_min_top: float = Field(1.2, ge=0, description="A top-hinged flap lifts upwards: its top is above this height (m, z up from the floor), above a worktop.")
+    neighbour_gap: float = Field(0.03, ge=0, description="Coplanar fronts closer than this (m) are neighbours (door pairs, drawer stacks).")
+    frame_max_width: float = Field(0.2, ge=0, description="Widest stile/rail of a frame-and-panel front (m).")
+    frame_depth: tuple[float, float] = Field((0.001, 0.03), description="Frame pieces stand this far proud of a recessed panel (min, max; m) ...")
+    raised_depth: tuple[float, float] = Field((-0.016, -0.003), description="... or a raised panel stands this far proud of them (min, max; m, negative: frame behind the panel).")
+    rim_depth: float = Field(0.03, ge=0, description="A front's edge/bevel facets reach this far behind its plane (m) ...")
+    rim_margin: float = Field(0.02, ge=0, description="... and this far outside its rectangle (chamfered edges; m).")
+
+
+class HeuristicConfig(StageConfig):
+    """The weight-free heuristic: planar facets and fronts on the scan mesh, per-frame renders, and the
+    image path (fronts found in the colour frames: seams, handles) and sliding-door pairs."""
+
+    fronts: FrontRulesConfig = Field(default_factory=FrontRulesConfig, description="Front rules on the scan mesh.")
+    facet_weld_m: float = Field(0.001, gt=0, description="Planar facets: vertices closer than this (m) are merged before joining faces.")
+    facet_max_angle_deg: float = Field(12.0, ge=0, le=180, description="Planar facets: faces sharing an edge join when their normals differ by at most this (deg).")
+    render_scale: float = Field(0.5, gt=0, le=1, description="Per-frame front renders at this fraction of the colour size (upsampled).")
+    n_probe: int = Field(24, ge=1, description="Frames (evenly spread) rendered at quarter size to find which facets the cameras see.")
+    probe_view_px: int = Field(4, ge=1, description="A facet counts as seen in a probe view with at least this many pixels ...")
+    probe_min_views: int = Field(2, ge=1, description="... and is visible when seen in this many probe views ...")
+    probe_min_px: int = Field(40, ge=0, description="... with at least this many pixels over all probe views.")
+    min_mask_px: int = Field(150, ge=0, description="A front yields a mask in a frame when it covers at least this many pixels there.")
+
+    # image path: fronts in the colour frames
     image_fronts: bool = Field(True, description="Also find fronts in the colour frames (real scans have no seams in the mesh).")
     ortho_resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
     max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
@@ -49,6 +83,33 @@ class HeuristicConfig(StageConfig):
     sliding_max_overlap: float = Field(0.12, ge=0, description="Sliding doors: the two fronts' outlines overlap by at most this (m).")
     sliding_max_gap: float = Field(0.02, ge=0, description="Sliding doors: ... or leave at most this gap between them (m).")
     sliding_min_height_overlap: float = Field(0.9, ge=0, le=1, description="Sliding doors: share of the smaller height the two fronts share.")
+    sliding_min_parallel: float = Field(0.97, ge=0, le=1, description="Sliding doors: |cos| between the two fronts' normals at least this.")
+    plane_offset_tol: float = Field(0.025, ge=0, description="Image path: faces this close to a vertical plane belong to it (m).")
+    plane_angle_tol_deg: float = Field(12.0, ge=0, description="Image path: faces whose normal is within this of a plane's belong to it (deg).")
+    min_plane_area: float = Field(0.08, ge=0, description="Image path: smallest vertical plane photographed (m^2; at least min_w x min_h).")
+    plane_cell: float = Field(0.04, gt=0, description="Image path: pieces of one plane farther apart than this are separate planes (m).")
+    plane_min_fragment_area: float = Field(0.03, ge=0, description="Image path: fragments of a plane's coverage smaller than this are not part of it (m^2).")
+    face_depth: tuple[float, float] = Field((-0.02, 0.07), description="Image path: faces this far behind/in front of the plane are taken into a front (m).")
+    outline_fill_px: int = Field(20, ge=0, description="Image path: holes and notches up to this many orthophoto px wide are inside a plane's outline (handle shadows).")
+    protrusion_depth: tuple[float, float] = Field((0.012, 0.09), description="Image path: mesh faces this far in front of the plane mark handles (m).")
+    ortho_max_side_px: int = Field(1200, ge=1, description="Orthophotos of very large planes get a coarser grid, at most this many px a side.")
+    ortho_min_cos: float = Field(0.3, ge=0, le=1, description="Orthophotos: views more grazing than this cos to the plane are not used.")
+    ortho_render_scale: float = Field(0.5, gt=0, le=1, description="Orthophotos: face-id buffer size relative to the colour image.")
+    ortho_erode_px: int = Field(3, ge=0, description="Orthophotos: depth-buffer pixels kept this far from depth jumps (occluder outlines).")
+    ortho_edge_jump: float = Field(0.05, gt=0, description="Orthophotos: a depth jump between neighbouring pixels marking an outline (m).")
+    ortho_depth_tol: float = Field(0.03, ge=0, description="Orthophotos: a plane point is seen when the scan is within this (m, +1 % of the distance).")
+    ortho_margin: float = Field(0.02, ge=0, description="Orthophotos: grid margin around a plane's extent (m).")
+    calib_scale_range: tuple[float, float] = Field((0.84, 1.12), description="Colour calibration: focal scales searched.")
+    calib_shift_range_px: float = Field(16.0, ge=0, description="Colour calibration: principal-point shifts searched (px at 640 px width).")
+    calib_min_gain: float = Field(0.2, ge=0, le=1, description="Colour calibration: used only when it cuts the disagreement by this fraction.")
+    min_front_side: float = Field(0.1, ge=0, description="Image cells: no cell narrower than this (m).")
+    handle_aspect: float = Field(2.2, ge=1, description="Image handles: long side at least this times the short side.")
+    handle_background_win: float = Field(0.12, gt=0, description="Image handles: window of the local background (m).")
+    cell_min_seen: float = Field(0.55, ge=0, le=1, description="Image cells: share of a cell the plane's faces must cover.")
+    max_clutter: float = Field(0.18, ge=0, le=1, description="Image cells: share of a cell's pixels off its local background above which it is clutter (posters, tiles, shelves).")
+    handle_outline_margin: float = Field(0.02, ge=0, description="Image handles: colour blobs this close to the plane's outline are not handles (m).")
+    texture_factor: float = Field(3.0, ge=0, description="Image path: handle/seam thresholds rise to this many times the plane's median response (textured planes).")
+    max_split_depth: int = Field(6, ge=0, description="Image cells: guillotine split recursion depth.")
 
 
 class PerceptionConfig(StageConfig):
@@ -70,8 +131,8 @@ class PerceptionConfig(StageConfig):
     articulation_endpoint: str | None = Field(None, description="OPDMulti HTTP endpoint or command (JSON contract).")
     batch_size: int = Field(8, ge=1, description="Frames per model call on GPU.")
     device: str = Field("auto", description="'auto', 'cpu', 'cuda', 'cuda:N'.")
-    oracle: OracleNoiseConfig = Field(default_factory=OracleNoiseConfig)
-    heuristic: HeuristicConfig = Field(default_factory=HeuristicConfig)
+    oracle: OracleNoiseConfig = Field(default_factory=OracleNoiseConfig, description="Oracle backend: how imperfect its ground truth is made.")
+    heuristic: HeuristicConfig = Field(default_factory=HeuristicConfig, description="Heuristic backend: facets, front rules, image path, sliding doors.")
 
     @field_validator("tag_filter_endpoint", "articulation_endpoint")
     @classmethod

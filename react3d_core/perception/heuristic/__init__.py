@@ -16,20 +16,13 @@ from ...data.frames import SceneInput
 from ..interfaces import Perception
 from .backend import (HeuristicArticulation, HeuristicModel, HeuristicPointSegmenter, HeuristicSegmenter,
                       HeuristicTagger, KeepOpenable)
-from .fronts import FrontRules
-from .image_fronts import params_from_config
-from .sliding import SlidingRules
 
 STAGE_VERSION = "5"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames; 4: sliding doors; 5: straight seams by line median, handle shadows filled, texture-adaptive clutter
 
 
 def make_heuristic(scene: SceneInput, config: PerceptionConfig) -> Perception:
     """Build the heuristic backend for ``scene`` (facets and fronts are computed once here)."""
-    image = params_from_config(config.heuristic) if config.heuristic.image_fronts else None
-    h = config.heuristic
-    sliding = SlidingRules(track_offset=tuple(h.sliding_track_offset), max_overlap=h.sliding_max_overlap,
-                           max_gap=h.sliding_max_gap, min_height_overlap=h.sliding_min_height_overlap)
-    model = HeuristicModel(scene, FrontRules(), image=image, sliding=sliding)
+    model = HeuristicModel(scene, config.heuristic)
     return Perception(name="heuristic", tagger=HeuristicTagger(model), tag_filter=KeepOpenable(),
                       segmenter=HeuristicSegmenter(model), point_segmenter=HeuristicPointSegmenter(model),
                       articulation=HeuristicArticulation(model), version=STAGE_VERSION)

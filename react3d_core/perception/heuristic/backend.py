@@ -10,38 +10,49 @@ from __future__ import annotations
 import logging
 from collections import OrderedDict
 from collections.abc import Sequence
+from typing import Any
 
 import cv2
 import numpy as np
 
+from ...config.perception import HeuristicConfig
 from ...data.frames import Frame, SceneInput
 from ...data.masks import ArticulationPrediction, Mask2D
 from ...data.mesh import TriMesh, load_mesh
 from ...raster import Rasterizer
 from ...scene_io.images import frame_rgb
 from .facets import planar_facets
-from .fronts import Front, FrontRules, find_fronts
-from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts
-from .sliding import SlidingRules, mark_sliding
+from .fronts import Front, find_fronts
+from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts, params_from_config
+from .sliding import SlidingRules, mark_sliding, sliding_from_config
 
 log = logging.getLogger("react3d.perception")
 
 OPENABLE_TAGS = ("cabinet", "drawer", "door", "wardrobe", "dresser", "refrigerator", "oven", "dishwasher")
-MIN_MASK_PX = 150
+_FROM_CONFIG: Any = object()  # image/sliding parameters not given: built from the config
 
 
 class HeuristicModel:
-    """Facets, fronts and per-frame renders of one scene."""
+    """Facets, fronts and per-frame renders of one scene. Every threshold comes from ``config``
+    (``perception.heuristic``; defaults when None); ``image`` / ``sliding`` override the image path's
+    and the sliding-door rule's parameters (None switches that step off)."""
 
-    def __init__(self, scene: SceneInput, rules: FrontRules = FrontRules(), scale: float = 0.5, n_probe: int = 24,
-                 image: ImageFrontParams | None = ImageFrontParams(), sliding: SlidingRules | None = SlidingRules()) -> None:
+    def __init__(self, scene: SceneInput, config: HeuristicConfig | None = None, *,
+                 image: ImageFrontParams | None = _FROM_CONFIG, sliding: SlidingRules | None = _FROM_CONFIG) -> None:
+        h = config if config is not None else HeuristicConfig()
+        if image is _FROM_CONFIG:
+            image = params_from_config(h) if h.image_fronts else None
+        if sliding is _FROM_CONFIG:
+            sliding = sliding_from_config(h)
+        rules = h.fronts
+        self.config = h
         self.scene = scene
         self.mesh: TriMesh = load_mesh(scene.mesh_path)
         self.raster = Rasterizer(self.mesh)
-        self.scale = scale
-        self.facets = planar_facets(self.mesh)
+        self.scale = h.render_scale
+        self.facets = planar_facets(self.mesh, h.facet_weld_m, h.facet_max_angle_deg)
         self._cache: OrderedDict[str, tuple[np.ndarray, np.ndarray]] = OrderedDict()
-        visible, glimpsed, view_dirs = self._visible_facets(n_probe)
+        visible, glimpsed, view_dirs = self._visible_facets(h.n_probe)
         cams = np.array([f.c2w[:3, 3] for f in scene.frames])
         self.fronts: list[Front] = find_fronts(self.mesh, self.facets, visible, cams.mean(0), rules, glimpsed, view_dirs)
         self.image: ImageFronts | None = None
@@ -74,8 +85,10 @@ class HeuristicModel:
         return True
 
     def _visible_facets(self, n_probe: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per facet: clearly visible (>= 40 px over >= 2 probe views), glimpsed (any pixel), and the
-        pixel-weighted sum of unit directions towards the cameras that saw it (orients its normal)."""
+        """Per facet: clearly visible (>= ``probe_min_px`` px over >= ``probe_min_views`` probe views of
+        >= ``probe_view_px`` px), glimpsed (any pixel), and the pixel-weighted sum of unit directions
+        towards the cameras that saw it (orients its normal)."""
+        h = self.config
         idx = np.unique(np.linspace(0, len(self.scene.frames) - 1, min(n_probe, len(self.scene.frames))).round().astype(int))
         px = np.zeros(self.facets.n, np.int64)
         seen = np.zeros(self.facets.n, np.int64)
@@ -89,12 +102,12 @@ class HeuristicModel:
             lab = self.facets.labels[hit]
             c = np.bincount(lab, minlength=self.facets.n)
             px += c
-            seen += c >= 4
+            seen += c >= h.probe_view_px
             to_cam = f.c2w[:3, 3] - centroids[hit]
             to_cam /= np.maximum(np.linalg.norm(to_cam, axis=1, keepdims=True), 1e-9)
             for ax in range(3):
                 dirs[:, ax] += np.bincount(lab, weights=to_cam[:, ax], minlength=self.facets.n)
-        return (px >= 40) & (seen >= 2), px > 0, dirs
+        return (px >= h.probe_min_px) & (seen >= h.probe_min_views), px > 0, dirs
 
     def render(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
         """(front id, face id) images at the frame's RGB size; -1 = none."""
@@ -115,7 +128,7 @@ class HeuristicModel:
     def masks(self, frame: Frame) -> list[tuple[int, np.ndarray]]:
         fronts, _ = self.render(frame)
         counts = np.bincount(fronts[fronts >= 0].ravel(), minlength=len(self.fronts))
-        return [(int(k), fronts == k) for k in np.flatnonzero(counts >= MIN_MASK_PX)]
+        return [(int(k), fronts == k) for k in np.flatnonzero(counts >= self.config.min_mask_px)]
 
 
 def _box(mask: np.ndarray) -> tuple[float, float, float, float]:

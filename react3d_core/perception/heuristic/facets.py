@@ -13,7 +13,10 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
+from ...config.perception import HeuristicConfig
 from ...data.mesh import TriMesh
+
+_DEFAULT = HeuristicConfig()  # defaults live in the config (perception.heuristic.facet_*)
 
 
 def weld(vertices: np.ndarray, tol: float) -> np.ndarray:
@@ -56,8 +59,9 @@ class Facets:
         return len(self.areas)
 
 
-def planar_facets(mesh: TriMesh, weld_m: float = 0.001, max_angle_deg: float = 12.0) -> Facets:
-    """Split the mesh into facets (see module docstring); fully vectorized."""
+def planar_facets(mesh: TriMesh, weld_m: float = _DEFAULT.facet_weld_m, max_angle_deg: float = _DEFAULT.facet_max_angle_deg) -> Facets:
+    """Split the mesh into facets (see module docstring); fully vectorized. The pipeline passes
+    ``perception.heuristic.facet_weld_m`` / ``facet_max_angle_deg``."""
     rep = weld(mesh.vertices, weld_m)
     faces = rep[mesh.faces]
     normals, areas = face_normals(mesh)

@@ -19,29 +19,34 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from ...config.perception import HeuristicConfig
 from .orthophoto import Orthophoto
+
+_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic)
 
 
 @dataclass(frozen=True)
 class CellParams:
-    seam_contrast: float = 0.01      # a seam pixel is this much darker than both sides (fraction of mean)
-    seam_span: float = 0.35          # a seam covers this fraction of the cell's seen extent ...
-    seam_prominence: float = 0.3     # ... and this much more than the lines around it (median over 2 x min_front)
-    seam_prominence_h: float = 0.5   # the same for horizontal seams (reflections of table edges, shelves are horizontal)
-    min_front: float = 0.1           # m: no cell narrower than this
-    handle_contrast: float = 0.12    # colour distance of handle pixels from the local background
-    handle_len: tuple[float, float] = (0.1, 0.5)   # m: long side of a handle
-    handle_thick: tuple[float, float] = (0.014, 0.07)  # m: short side of a handle (protruding bars smear by parallax)
-    handle_aspect: float = 2.2
-    background_win: float = 0.12     # m: window of the local background for handles
-    min_seen: float = 0.55           # a cell's mesh coverage fraction
-    max_clutter: float = 0.18        # fraction of a cell's pixels off its local background (posters, tiles, shelves)
-    outline_margin: float = 0.02     # m: colour blobs this close to the plane's outline are not handles
-    texture_factor: float = 3.0      # handle/seam thresholds rise to this many times the plane's median response
-    seam_z: float = 15.0             # a straight seam: the line's median brightness dips this many noise units below its neighbours
-    step_contrast: float = 0.25      # a colour step along a whole line (a door leaf in a pale wall): colour distance across it ...
-    step_z: float = 15.0             # ... and in noise units of the cell's steps
-    max_depth: int = 6               # guillotine recursion depth
+    """Seam/handle/cell parameters, built from ``HeuristicConfig`` by ``image_fronts.params_from_config``."""
+
+    seam_contrast: float = _H.seam_contrast      # a seam pixel is this much darker than both sides (fraction of mean)
+    seam_span: float = _H.seam_span              # a seam covers this fraction of the cell's seen extent ...
+    seam_prominence: float = _H.seam_prominence  # ... and this much more than the lines around it (median over 2 x min_front)
+    seam_prominence_h: float = _H.seam_prominence_h  # the same for horizontal seams (reflections of table edges, shelves are horizontal)
+    min_front: float = _H.min_front_side         # m: no cell narrower than this
+    handle_contrast: float = _H.handle_contrast  # colour distance of handle pixels from the local background
+    handle_len: tuple[float, float] = _H.handle_len      # m: long side of a handle
+    handle_thick: tuple[float, float] = _H.handle_thick  # m: short side of a handle (protruding bars smear by parallax)
+    handle_aspect: float = _H.handle_aspect
+    background_win: float = _H.handle_background_win  # m: window of the local background for handles
+    min_seen: float = _H.cell_min_seen           # a cell's mesh coverage fraction
+    max_clutter: float = _H.max_clutter          # fraction of a cell's pixels off its local background (posters, tiles, shelves)
+    outline_margin: float = _H.handle_outline_margin  # m: colour blobs this close to the plane's outline are not handles
+    texture_factor: float = _H.texture_factor    # handle/seam thresholds rise to this many times the plane's median response
+    seam_z: float = _H.seam_z                    # a straight seam: the line's median brightness dips this many noise units below its neighbours
+    step_contrast: float = _H.step_contrast      # a colour step along a whole line (a door leaf in a pale wall): colour distance across it ...
+    step_z: float = _H.step_z                    # ... and in noise units of the cell's steps
+    max_depth: int = _H.max_split_depth          # guillotine recursion depth
 
 
 @dataclass

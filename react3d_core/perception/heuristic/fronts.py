@@ -16,29 +16,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ...config.perception import FrontRulesConfig
 from ...data.mesh import TriMesh
 from ...data.parts import Articulation
 from .facets import Facets
 
 
-@dataclass(frozen=True)
-class FrontRules:
-    min_w: float = 0.12
-    max_w: float = 1.3
-    min_h: float = 0.1
-    max_h: float = 2.3
-    max_tilt: float = 0.25            # |n_z| of a vertical front
-    min_fill: float = 0.8             # facet area / bounding rectangle
-    handle_max_area: float = 0.03     # m^2 of one handle facet
-    handle_depth: tuple[float, float] = (0.002, 0.09)  # handle facets in front of the plane (m)
-    drawer_max_h: float = 0.45          # deep drawers reach ~0.45 m; oven/dishwasher doors are >= 0.5 m
-    flap_min_top: float = 1.2           # a top-hinged flap lifts upwards: its top is above a worktop (m, z up from the floor)
-    neighbour_gap: float = 0.03
-    frame_max_width: float = 0.2      # stiles/rails of a frame-and-panel front (m)
-    frame_depth: tuple[float, float] = (0.001, 0.03)  # frame pieces stand proud of a recessed panel ...
-    raised_depth: tuple[float, float] = (-0.016, -0.003)  # ... or a raised panel stands proud of them
-    rim_depth: float = 0.03           # edge/bevel facets of a front reach this far behind its plane
-    rim_margin: float = 0.02          # ... and this far outside its rectangle (chamfered edges)
+FrontRules = FrontRulesConfig  # the rules are the config section perception.heuristic.fronts (descriptions there)
 
 
 @dataclass

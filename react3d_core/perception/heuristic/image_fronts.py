@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from ...config.perception import HeuristicConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
@@ -26,27 +27,49 @@ from .orthophoto import ColourCalibration, Orthophoto, OrthoParams, build_orthop
 from .planes import Plane, vertical_planes
 
 
+_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic)
+
+
 @dataclass(frozen=True)
 class ImageFrontParams:
+    """The image path's parameters, built from ``HeuristicConfig`` by ``params_from_config``."""
+
     ortho: OrthoParams = OrthoParams()
     cells: CellParams = CellParams()
-    plane_offset_tol: float = 0.025   # m: faces this close to a plane belong to it
-    plane_angle_tol_deg: float = 12.0
-    min_plane_area: float = 0.08      # m²
-    face_depth: tuple[float, float] = (-0.02, 0.07)  # m behind / in front of the plane taken into a front
-    min_tile_side: float = 0.25       # m: handle-less cells smaller than this both ways are tiles, not fronts
-    handleless_min_seams: int = 2     # a handle-less cell cut out by this many straight seams is a front (0: never)
+    plane_offset_tol: float = _H.plane_offset_tol        # m: faces this close to a plane belong to it
+    plane_angle_tol_deg: float = _H.plane_angle_tol_deg
+    min_plane_area: float = _H.min_plane_area            # m²
+    plane_cell: float = _H.plane_cell                    # m: pieces of one plane farther apart are separate planes
+    plane_min_fragment_area: float = _H.plane_min_fragment_area  # m²: smaller coverage fragments are not the plane's
+    face_depth: tuple[float, float] = _H.face_depth      # m behind / in front of the plane taken into a front
+    outline_fill_px: int = _H.outline_fill_px            # holes/notches this wide are inside the plane's outline
+    protrusion_depth: tuple[float, float] = _H.protrusion_depth  # m in front of the plane: mesh handles
+    min_tile_side: float = _H.min_tile_side              # m: handle-less cells smaller than this both ways are tiles, not fronts
+    handleless_min_seams: int = _H.handleless_min_seams  # a handle-less cell cut out by this many straight seams is a front (0: never)
 
 
-def params_from_config(cfg: "HeuristicConfig") -> ImageFrontParams:  # noqa: F821 - pydantic model
-    """The image path's parameters from the pipeline config (every threshold lives there)."""
+def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
+    """The image path's parameters from the pipeline config (every threshold lives there; the one
+    place they are built)."""
     return ImageFrontParams(
-        ortho=OrthoParams(resolution=cfg.ortho_resolution, max_views=cfg.max_views, calibrate=cfg.calibrate_colour),
+        ortho=OrthoParams(resolution=cfg.ortho_resolution, max_side_px=cfg.ortho_max_side_px, max_views=cfg.max_views,
+                          min_cos=cfg.ortho_min_cos, render_scale=cfg.ortho_render_scale, erode_px=cfg.ortho_erode_px,
+                          edge_jump=cfg.ortho_edge_jump, depth_tol=cfg.ortho_depth_tol, margin=cfg.ortho_margin,
+                          calibrate=cfg.calibrate_colour, scale_range=tuple(cfg.calib_scale_range),
+                          shift_range_px=cfg.calib_shift_range_px, min_gain=cfg.calib_min_gain),
         cells=CellParams(seam_contrast=cfg.seam_contrast, seam_span=cfg.seam_span, seam_prominence=cfg.seam_prominence,
-                         seam_prominence_h=cfg.seam_prominence_h, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
-                         step_z=cfg.step_z, handle_contrast=cfg.handle_contrast,
-                         handle_len=tuple(cfg.handle_len), handle_thick=tuple(cfg.handle_thick)),
-        min_tile_side=cfg.min_tile_side, handleless_min_seams=cfg.handleless_min_seams)
+                         seam_prominence_h=cfg.seam_prominence_h, min_front=cfg.min_front_side,
+                         handle_contrast=cfg.handle_contrast, handle_len=tuple(cfg.handle_len),
+                         handle_thick=tuple(cfg.handle_thick), handle_aspect=cfg.handle_aspect,
+                         background_win=cfg.handle_background_win, min_seen=cfg.cell_min_seen,
+                         max_clutter=cfg.max_clutter, outline_margin=cfg.handle_outline_margin,
+                         texture_factor=cfg.texture_factor, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
+                         step_z=cfg.step_z, max_depth=cfg.max_split_depth),
+        plane_offset_tol=cfg.plane_offset_tol, plane_angle_tol_deg=cfg.plane_angle_tol_deg,
+        min_plane_area=cfg.min_plane_area, plane_cell=cfg.plane_cell, plane_min_fragment_area=cfg.plane_min_fragment_area,
+        face_depth=tuple(cfg.face_depth), outline_fill_px=cfg.outline_fill_px,
+        protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
+        handleless_min_seams=cfg.handleless_min_seams)
 
 
 @dataclass
@@ -61,7 +84,7 @@ class ImageFronts:
     calibration: ColourCalibration
 
 
-def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = 0.03) -> np.ndarray:
+def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = _H.plane_min_fragment_area) -> np.ndarray:
     """Grid pixels covered by the plane's own faces (centroids splatted, small holes closed)."""
     h, w = o.n_views.shape
     cen = mesh.vertices[mesh.faces[o.plane.faces]].mean(1)
@@ -80,7 +103,7 @@ def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = 0.03) -> np.nda
     return keep[lab]
 
 
-def cov_outline(cov: np.ndarray, px: int = 20) -> np.ndarray:
+def cov_outline(cov: np.ndarray, px: int = _H.outline_fill_px) -> np.ndarray:
     """The plane's outline with holes and notches up to ``px`` wide filled: a pixel is inside when
     the plane is within ``px`` on both sides of it along a row or along a column (a handle's scanning
     shadow is a hole, or a notch where the handle sits at the front's edge; a closing misses both once
@@ -95,7 +118,7 @@ def cov_outline(cov: np.ndarray, px: int = 20) -> np.ndarray:
 
 
 def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
-                   depth: tuple[float, float] = (0.012, 0.09)) -> np.ndarray:
+                   depth: tuple[float, float] = _H.protrusion_depth) -> np.ndarray:
     """Grid pixels under outward-facing faces standing ``depth`` in front of the plane (handles in
     the mesh), splatted by centroid and closed over 2 px."""
     h, w = o.n_views.shape
@@ -117,7 +140,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     faces of fronts already found on the mesh: cells overlapping them are left to the mesh rules."""
     cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, 3))
     planes = vertical_planes(mesh, cams.mean(0), max_tilt=rules.max_tilt, angle_tol_deg=params.plane_angle_tol_deg,
-                             offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h))
+                             offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h),
+                             cell=params.plane_cell)
     orthos, calib = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
     centroids = mesh.vertices[mesh.faces].mean(1)
     normals, _ = face_normals(mesh)
@@ -125,12 +149,12 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     diffs = []
     for o in orthos:
-        cov = coverage_map(o, mesh)
+        cov = coverage_map(o, mesh, params.plane_min_fragment_area)
         o.n_views[~cov] = 0  # where the plane's own faces are not (floor, worktop edge seen at the same depth)
         diff = off_background(o, params.cells)
         diffs.append(diff)
-        outline = cov_outline(cov)  # handle shadows are holes in the plane, not its outline
-        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals) & outline, outline)
+        outline = cov_outline(cov, params.outline_fill_px)  # handle shadows are holes in the plane, not its outline
+        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals, params.protrusion_depth) & outline, outline)
         clutter = (diff > off_threshold(diff, o.n_views > 0, params.cells)) & (o.n_views > 0)
         for h in handles:  # a handle is not clutter
             clutter[h.pixels[:, 1], h.pixels[:, 0]] = False

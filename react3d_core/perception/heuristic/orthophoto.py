@@ -22,26 +22,31 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from ...config.perception import HeuristicConfig
 from ...data.frames import Frame
 from ...raster import Rasterizer
 from .planes import Plane
 
+_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic.ortho_*, calib_*)
+
 
 @dataclass(frozen=True)
 class OrthoParams:
-    resolution: float = 0.004     # m per grid pixel
-    max_side_px: int = 1200       # coarser grid for very large planes
-    max_views: int = 30           # views per plane, best first
-    min_cos: float = 0.3          # views more grazing than this are not used
-    render_scale: float = 0.5     # face-id buffer size relative to the colour image
-    erode_px: int = 3             # depth-buffer pixels kept away from depth jumps (occluder outlines)
-    edge_jump: float = 0.05       # m: a depth jump between neighbouring pixels that marks an outline
-    depth_tol: float = 0.03       # m (+1 % of the distance): a plane point is seen when the scan is there
-    margin: float = 0.02          # m of grid around a plane's extent
-    calibrate: bool = True        # self-calibrate colour focal scale / principal-point shift
-    scale_range: tuple[float, float] = (0.84, 1.12)
-    shift_range_px: float = 16.0  # at 640 px image width
-    min_gain: float = 0.2         # a calibration must cut the disagreement by this fraction to be used
+    """Orthophoto parameters, built from ``HeuristicConfig`` by ``image_fronts.params_from_config``."""
+
+    resolution: float = _H.ortho_resolution      # m per grid pixel
+    max_side_px: int = _H.ortho_max_side_px      # coarser grid for very large planes
+    max_views: int = _H.max_views                # views per plane, best first
+    min_cos: float = _H.ortho_min_cos            # views more grazing than this are not used
+    render_scale: float = _H.ortho_render_scale  # face-id buffer size relative to the colour image
+    erode_px: int = _H.ortho_erode_px            # depth-buffer pixels kept away from depth jumps (occluder outlines)
+    edge_jump: float = _H.ortho_edge_jump        # m: a depth jump between neighbouring pixels that marks an outline
+    depth_tol: float = _H.ortho_depth_tol        # m (+1 % of the distance): a plane point is seen when the scan is there
+    margin: float = _H.ortho_margin              # m of grid around a plane's extent
+    calibrate: bool = _H.calibrate_colour        # self-calibrate colour focal scale / principal-point shift
+    scale_range: tuple[float, float] = _H.calib_scale_range
+    shift_range_px: float = _H.calib_shift_range_px  # at 640 px image width
+    min_gain: float = _H.calib_min_gain          # a calibration must cut the disagreement by this fraction to be used
 
 
 @dataclass

@@ -13,19 +13,30 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...config.perception import HeuristicConfig
 from ...data.parts import Articulation
 from .fronts import Front
 
 
+_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic.sliding_*)
+
+
 @dataclass(frozen=True)
 class SlidingRules:
-    """Thresholds of the two-track rule (from ``HeuristicConfig``)."""
+    """Thresholds of the two-track rule, built from ``HeuristicConfig`` by ``sliding_from_config``."""
 
-    track_offset: tuple[float, float] = (0.008, 0.06)  # plane offset between the two doors (m)
-    max_overlap: float = 0.12      # the doors' outlines overlap by at most this (m) ...
-    max_gap: float = 0.02          # ... or leave at most this gap between them (m)
-    min_height_overlap: float = 0.9  # share of the smaller height the two doors have in common
-    min_parallel: float = 0.97     # |cos| between the fronts' normals
+    track_offset: tuple[float, float] = _H.sliding_track_offset  # plane offset between the two doors (m)
+    max_overlap: float = _H.sliding_max_overlap  # the doors' outlines overlap by at most this (m) ...
+    max_gap: float = _H.sliding_max_gap          # ... or leave at most this gap between them (m)
+    min_height_overlap: float = _H.sliding_min_height_overlap  # share of the smaller height the two doors have in common
+    min_parallel: float = _H.sliding_min_parallel  # |cos| between the fronts' normals
+
+
+def sliding_from_config(cfg: HeuristicConfig) -> SlidingRules:
+    """The two-track rule's thresholds from the pipeline config (the one place they are built)."""
+    return SlidingRules(track_offset=tuple(cfg.sliding_track_offset), max_overlap=cfg.sliding_max_overlap,
+                        max_gap=cfg.sliding_max_gap, min_height_overlap=cfg.sliding_min_height_overlap,
+                        min_parallel=cfg.sliding_min_parallel)
 
 
 def _u_overlap(f: Front, g: Front) -> float:
