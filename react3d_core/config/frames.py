@@ -19,5 +19,6 @@ class FrameSelectionConfig(StageConfig):
     keyframe_cap: int = Field(300, ge=1, description="Keyframe mode: at most this many frames (evenly subsampled from the keyframes).")
     coverage_width: int = Field(64, ge=0, description="Keyframe mode: width (px) of the face-id buffer used to measure what a view adds; 0 = motion only.")
     coverage_target_views: int = Field(10, ge=1, description="Keyframe mode: surface seen in this many kept frames counts as covered.")
+    coverage_voxel_m: float = Field(0.05, gt=0, description="Keyframe mode: surface is counted per voxel of this side (m) when measuring what a view adds (about one coverage-buffer pixel at 2 m).")
     coverage_min_new: float = Field(0.05, ge=0, le=1, description="Keyframe mode: keep a moved frame only if at least this fraction of its surface pixels is not yet covered.")
     image_width: int = Field(960, ge=32, description="RGB working width; the reference worked at 960x720. K is rescaled with it.")

@@ -18,6 +18,11 @@ class FusionConfig(StageConfig):
     work_width: int | None = Field(320, ge=16, description="Render, lift and score views at this image width (None: the masks' own size).")
     weld_m: float = Field(0.005, ge=0, description="Vertices closer than this count as one for connectivity (scans may not be welded).")
     attach_m: float = Field(0.02, ge=0, description="Components this close to a part's largest component stay with it (handles on doors).")
+    max_anchors: int = Field(8, ge=1, description="Face graph: anchor faces sampled per mask (each lifted face is paired with them; enough to bridge gaps).")
+    distinct_jaccard: float = Field(0.95, ge=0, le=1, description="A community found again at another resolution (face Jaccard above this) is merged into the first.")
+    claimed_share: float = Field(0.8, ge=0, le=1, description="A proposal with more than this share of its faces in earlier candidates is not re-segmented (it would re-segment to them).")
+    duplicate_iou: float = Field(0.5, ge=0, le=1, description="Candidates of several resolutions: a later one with vertex IoU above this with a kept one is dropped ...")
+    duplicate_contained: float = Field(0.8, ge=0, le=1, description="... as is one with more than this share of its vertices inside a kept one (a piece of it).")
 
 
 class TopKConfig(StageConfig):
@@ -36,6 +41,7 @@ class ClipConfig(StageConfig):
     enabled: bool = Field(True, description="Clip segmented meshes to the front plane.")
     ransac_threshold_m: float = Field(0.02, gt=0, description="RANSAC inlier distance (m).")
     ransac_iterations: int = Field(1000, ge=1, description="RANSAC iterations.")
+    ransac_max_points: int = Field(2000, ge=3, description="RANSAC runs on at most this many face centroids (random subset).")
     max_abs_nz: float = Field(0.7071, ge=0, le=1, description="Near-vertical points: |n_z| <= sin 45 deg.")
     keep_behind_m: float = Field(0.03, ge=0, description="Keep geometry up to this far behind the plane (slab thickness).")
     seed: int = Field(0, description="RANSAC seed.")

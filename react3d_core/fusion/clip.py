@@ -12,8 +12,6 @@ import numpy as np
 from ..config import ClipConfig
 from ..data.mesh import TriMesh
 
-MAX_POINTS = 2000
-
 
 def face_geometry(mesh: TriMesh, face_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Centroids, unit normals and areas of ``face_ids``."""
@@ -34,8 +32,8 @@ def ransac_plane(points: np.ndarray, weights: np.ndarray, config: ClipConfig, vi
     if len(points) < 3:
         return None
     rng = np.random.default_rng(config.seed)
-    if len(points) > MAX_POINTS:
-        sel = rng.choice(len(points), MAX_POINTS, replace=False)
+    if len(points) > config.ransac_max_points:
+        sel = rng.choice(len(points), config.ransac_max_points, replace=False)
         points, weights = points[sel], weights[sel]
     idx = rng.integers(0, len(points), (config.ransac_iterations, 3))
     a, b, c = points[idx[:, 0]], points[idx[:, 1]], points[idx[:, 2]]

@@ -5,7 +5,7 @@ Two kinds of face pairs are counted, both linear in the lifted faces:
   sparse product — this is what separates two coplanar doors sharing an edge;
 * anchor pairs: every face of a mask is paired with the mask's ``a`` highest-priority faces
   (one global seeded priority, so the same pairs recur across masks and their counts add up),
-  ``a <= 8``, ``a * |mask| <= max_pairs_per_mask`` (a mask larger than that pairs its first max_pairs faces in a
+  ``a <= max_anchors`` (8), ``a * |mask| <= max_pairs_per_mask`` (a mask larger than that pairs its first max_pairs faces in a
   second global priority with one anchor). They tie together faces that are not adjacent (a door split
   by an occluder or a handle hole).
 Louvain runs on the graph contracted by mask signature (faces lying in exactly the same masks
@@ -20,8 +20,6 @@ import networkx as nx
 import numpy as np
 from scipy import sparse
 
-MAX_ANCHORS = 8  # anchors per mask: enough to bridge gaps, keeps pairs ~8 per lifted face
-
 
 def membership(face_sets: Sequence[np.ndarray], n_nodes: int) -> sparse.csr_matrix:
     """(n_masks, n_nodes) binary matrix of which nodes each mask covers."""
@@ -34,8 +32,9 @@ def membership(face_sets: Sequence[np.ndarray], n_nodes: int) -> sparse.csr_matr
     return m
 
 
-def anchor_pairs(face_sets: Sequence[np.ndarray], n_nodes: int, max_pairs: int, seed: int) -> np.ndarray:
-    """(P,2) sampled pairs (i < j), at most ``max_pairs`` per mask; duplicates across masks kept."""
+def anchor_pairs(face_sets: Sequence[np.ndarray], n_nodes: int, max_pairs: int, seed: int, max_anchors: int = 8) -> np.ndarray:
+    """(P,2) sampled pairs (i < j), at most ``max_pairs`` per mask, each face paired with at most
+    ``max_anchors`` anchors of its mask (config.fusion.max_anchors); duplicates across masks kept."""
     rng = np.random.default_rng(seed)
     prio = rng.permutation(n_nodes)
     prio2 = rng.permutation(n_nodes)  # picks the faces paired in masks larger than max_pairs
@@ -47,7 +46,7 @@ def anchor_pairs(face_sets: Sequence[np.ndarray], n_nodes: int, max_pairs: int, 
         if n > max_pairs:
             s = s[np.argpartition(prio2[s], max_pairs - 1)[:max_pairs]]
             n = max_pairs
-        a = int(min(n - 1, MAX_ANCHORS, max(1, max_pairs // n)))
+        a = int(min(n - 1, max_anchors, max(1, max_pairs // n)))
         anchors = s[np.argpartition(prio[s], a - 1)[:a]] if a < n else s
         i = np.repeat(s, len(anchors))
         j = np.tile(anchors, n)
@@ -57,7 +56,8 @@ def anchor_pairs(face_sets: Sequence[np.ndarray], n_nodes: int, max_pairs: int, 
     return np.concatenate(out) if out else np.zeros((0, 2), np.int64)
 
 
-def cooccurrence(face_sets: Sequence[np.ndarray], n_nodes: int, adjacency: np.ndarray, max_pairs: int, seed: int) -> sparse.coo_matrix:
+def cooccurrence(face_sets: Sequence[np.ndarray], n_nodes: int, adjacency: np.ndarray, max_pairs: int, seed: int,
+                 max_anchors: int = 8) -> sparse.coo_matrix:
     """Upper-triangular counts: how many masks contain both faces of each counted pair."""
     M = membership(face_sets, n_nodes).tocsc()
     cnt = []
@@ -67,7 +67,7 @@ def cooccurrence(face_sets: Sequence[np.ndarray], n_nodes: int, adjacency: np.nd
         if len(adj):
             c = np.asarray(M[:, adj[:, 0]].multiply(M[:, adj[:, 1]]).sum(0)).ravel()
             cnt.append(sparse.coo_matrix((c, (adj[:, 0], adj[:, 1])), shape=(n_nodes, n_nodes)).tocsr())
-    ap = anchor_pairs(face_sets, n_nodes, max_pairs, seed)
+    ap = anchor_pairs(face_sets, n_nodes, max_pairs, seed, max_anchors)
     if len(ap):
         a = sparse.coo_matrix((np.ones(len(ap), np.float32), (ap[:, 0], ap[:, 1])), shape=(n_nodes, n_nodes)).tocsr()
         a.sum_duplicates()

@@ -84,7 +84,7 @@ def prepare_fusion_mesh(mesh: TriMesh, config: PipelineConfig) -> FusionMesh:
     return FusionMesh(small, fmap, wf, edge_adjacency(wf))
 
 
-def _distinct(comms: Sequence[np.ndarray], n: int, same: float = 0.95) -> list[int]:
+def _distinct(comms: Sequence[np.ndarray], n: int, same: float) -> list[int]:
     """Indices of communities to keep: a community found again (Jaccard > ``same``) is dropped."""
     if not comms:
         return []
@@ -110,7 +110,7 @@ def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineCo
     if not sets:
         return []
     n = fm.n_faces
-    counts = cooccurrence(sets, n, fm.adjacency, fc.max_pairs_per_mask, fc.seed)
+    counts = cooccurrence(sets, n, fm.adjacency, fc.max_pairs_per_mask, fc.seed, fc.max_anchors)
     graph = face_graph(counts, fc.min_cooccurrence)
     M = membership(sets, n)
     support = np.asarray(M.sum(0)).ravel()
@@ -131,7 +131,7 @@ def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineCo
         if len(com) > fc.min_community_faces:
             kept.append((res, com))
     out: list[Proposal] = []
-    for i in _distinct([c for _, c in kept], n):
+    for i in _distinct([c for _, c in kept], n, fc.distinct_jaccard):
         res, com = kept[i]
         in_com = np.zeros(n, bool)
         in_com[com] = True

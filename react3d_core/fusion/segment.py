@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..config import PipelineConfig
+from ..config import FusionConfig, PipelineConfig
 from ..data.frames import Frame, SceneInput
 from ..data.masks import Mask2D
 from ..data.mesh import TriMesh
@@ -21,10 +21,6 @@ from .connectivity import largest_component
 from .lift import FrameLift, ViewStats, lift_with_stats
 from .proposals import FusionMesh, Proposal, fuse_proposals, prepare_fusion_mesh
 from .topk import top_views_from_stats
-
-DUPLICATE_IOU = 0.5
-CONTAINED = 0.8
-
 
 @dataclass
 class ProposalOutcome:
@@ -80,19 +76,20 @@ def _vertex_ids(mesh: TriMesh, faces: np.ndarray) -> np.ndarray:
     return np.unique(mesh.faces[faces].ravel()).astype(np.int64)
 
 
-def _duplicate(c: PartCandidate, k: PartCandidate) -> bool:
+def _duplicate(c: PartCandidate, k: PartCandidate, fc: FusionConfig) -> bool:
     inter = len(np.intersect1d(c.vertex_ids, k.vertex_ids, assume_unique=True))
     union = len(c.vertex_ids) + len(k.vertex_ids) - inter
-    return inter > DUPLICATE_IOU * union or inter > CONTAINED * len(c.vertex_ids)
+    return inter > fc.duplicate_iou * union or inter > fc.duplicate_contained * len(c.vertex_ids)
 
 
-def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh) -> list[PartCandidate]:
+def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh, config: FusionConfig = FusionConfig()) -> list[PartCandidate]:
     """Proposals of several Louvain resolutions often re-segment to the same part, or to a piece of
     it (seen cut off in their best view): keep the best-scored candidate, drop later ones with
-    vertex IoU > 0.5 or > 80 % of their vertices inside a kept one (issue 4's dedup still runs later)."""
+    vertex IoU > ``duplicate_iou`` or > ``duplicate_contained`` of their vertices inside a kept one
+    (issue 4's dedup still runs later)."""
     kept: list[PartCandidate] = []
     for c in sorted(cands, key=lambda c: (-c.score, -len(c.face_ids))):
-        if not any(_duplicate(c, k) for k in kept):
+        if not any(_duplicate(c, k, config) for k in kept):
             kept.append(c)
     for i, c in enumerate(kept):
         c.candidate_id = i
@@ -128,7 +125,7 @@ def candidates_from_proposals(
         prop, tv = proposals[i], tops[i]
         if not tv:
             continue
-        if claimed[prop.face_ids].mean() > CONTAINED:
+        if claimed[prop.face_ids].mean() > config.fusion.claimed_share:
             outcomes[i] = ProposalOutcome("claimed")
             continue
         frame = by_id[tv[0].frame_id]
@@ -160,7 +157,7 @@ def candidates_from_proposals(
     if trace is not None:
         trace.outcomes = outcomes
         trace.before_duplicates = list(out)
-    return drop_duplicates(out, mesh)
+    return drop_duplicates(out, mesh, config.fusion)
 
 
 def segment_parts(

@@ -21,8 +21,6 @@ from ..config.frames import FrameSelectionConfig
 from ..data.frames import Frame
 from ..raster import Rasterizer
 
-#: voxel edge (m) for counting how often a piece of surface was seen; about one low-res pixel at 2 m
-COVERAGE_VOXEL_M = 0.05
 _HASH_BITS = 22  # 4 M counters (16 MB); collisions only merge far-apart voxels' counts
 
 
@@ -50,7 +48,7 @@ def _even_cap(items: list[Frame], cap: int | None) -> list[Frame]:
     return [items[i] for i in idx]
 
 
-def _voxel_hashes(rast: Rasterizer, frame: Frame, width: int) -> np.ndarray:
+def _voxel_hashes(rast: Rasterizer, frame: Frame, width: int, voxel_m: float) -> np.ndarray:
     """Hashed voxel ids of the scan points this frame sees, from a ``width``-pixel-wide depth buffer."""
     intr = frame.intrinsics
     intr = intr.scaled(width, max(1, round(intr.height * width / intr.width)))
@@ -58,7 +56,7 @@ def _voxel_hashes(rast: Rasterizer, frame: Frame, width: int) -> np.ndarray:
     pts = unproject(res.depth, intr.K, frame.c2w)[res.depth > 0]
     if not len(pts):
         return np.zeros(0, np.int64)
-    ijk = np.floor(pts / COVERAGE_VOXEL_M).astype(np.int64)
+    ijk = np.floor(pts / voxel_m).astype(np.int64)
     h = (ijk[:, 0] * 73856093) ^ (ijk[:, 1] * 19349663) ^ (ijk[:, 2] * 83492791)
     return np.unique(h & ((1 << _HASH_BITS) - 1))
 
@@ -70,7 +68,7 @@ def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: Raste
     counts = np.zeros(1 << _HASH_BITS if use_cov else 0, np.int32)  # kept frames that saw each voxel (hashed)
     kept = [0]
     if use_cov:
-        counts[_voxel_hashes(rasterizer, frames[0], cfg.coverage_width)] += 1
+        counts[_voxel_hashes(rasterizer, frames[0], cfg.coverage_width, cfg.coverage_voxel_m)] += 1
     last = poses[0]
     skip_motion = skip_cov = 0
     for i in range(1, n):
@@ -80,7 +78,7 @@ def _keyframes(frames: list[Frame], cfg: FrameSelectionConfig, rasterizer: Raste
             skip_motion += 1
             continue
         if use_cov:
-            vox = _voxel_hashes(rasterizer, frames[i], cfg.coverage_width)
+            vox = _voxel_hashes(rasterizer, frames[i], cfg.coverage_width, cfg.coverage_voxel_m)
             new = float(np.mean(counts[vox] < cfg.coverage_target_views)) if vox.size else 0.0
             if new < cfg.coverage_min_new:
                 skip_cov += 1
