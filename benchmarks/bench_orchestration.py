@@ -2,7 +2,7 @@
 
     python3 benchmarks/bench_orchestration.py --frames 300 --json bench_orchestration.json
 
-Reports the same pipeline called directly (the task bodies in sequence, no Prefect), then through the
+Reports the same pipeline called directly (``react3d_core.pipeline.convert``, no Prefect), then through the
 flow (first run), then the cached re-run; Prefect overhead = flow wall - direct wall (negative when
 the flow's parallel fan-out wins), per-stage wall times as the flow measured them. Uses a private
 PREFECT_HOME / REACT3D_CACHE under --work.
@@ -21,29 +21,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 
 def run_direct(scene: str, out: Path, cfg: dict) -> float:
-    """The flow's task bodies called in sequence without Prefect (same code, same store)."""
-    from flows.convert_scene import ARTICULATION_KEYS, ASSEMBLY_KEYS, SEGMENTATION_KEYS, config_sections
-    from react3d_core.config import PipelineConfig
-    from tasks.articulation import articulate_body
-    from tasks.assembly import assemble_body, export_body, publish_body
-    from tasks.perception import perceive_body
-    from tasks.report import evaluate_body, report_body
-    from tasks.scene import fingerprint_body
-    from tasks.segmentation import segment_body
+    """The same pipeline without Prefect: ``react3d_core.pipeline.convert`` (same step functions, no store)."""
+    from react3d_core.pipeline import convert
 
     t0 = time.perf_counter()
-    c = PipelineConfig().with_overrides(cfg).model_dump(mode="json")
-    fr = c["frames"]
-    fp = fingerprint_body(scene, fr)
-    ids, b = fp["frame_ids"], c["perception"]["batch_size"]
-    perc = [perceive_body(scene, fr, ids[i:i + b], c["perception"]) for i in range(0, len(ids), b)]
-    seg = segment_body(scene, fr, perc, config_sections(c, SEGMENTATION_KEYS))
-    parts = [articulate_body(scene, fr, seg, i, perc, config_sections(c, ARTICULATION_KEYS)) for i in range(seg["n"])]
-    asm = assemble_body(scene, fp["sha256"] + "-direct", fr, parts, config_sections(c, ASSEMBLY_KEYS))
-    exp = export_body(asm, c["export"], list(c["export"]["formats"])) if c["export"]["formats"] else asm
-    manifest = publish_body(exp, str(out), fp["mesh_path"])
-    metrics = evaluate_body(manifest, fp["gt_dir"], c) if fp["gt_dir"] else None
-    report_body(manifest, scene, fr, metrics)
+    convert(scene, out, cfg)
     return time.perf_counter() - t0
 
 

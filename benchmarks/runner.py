@@ -84,7 +84,7 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
     """Child-process body: generate if missing, convert (timed), return timings and peak RSS.
 
     ``cold``: a scratch folder; the conversion then starts from an empty cache (see :func:`cold_cache`).
-    ``miss_causes``: also attribute each missed / mis-jointed GT part to a stage (flows.miss_causes), after
+    ``miss_causes``: also attribute each missed / mis-jointed GT part to a stage (benchmarks.miss_causes), after
     the timings and peak memory are taken.
     """
     scene_dir = Path(entry["scene_dir"])
@@ -103,7 +103,7 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
         out = {"manifest": str(manifest), "wall_s": wall, "peak_rss_mb": _peak_rss_mb(), "rss_before_mb": rss0}
         if miss_causes:
             try:
-                from flows.miss_causes import trace_scene
+                from benchmarks.miss_causes import trace_scene
 
                 out["miss_causes"] = trace_scene(str(scene_dir), str(manifest), config)
             except Exception as exc:  # noqa: BLE001 - a failed breakdown must not fail the scene's scores

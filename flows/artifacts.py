@@ -16,14 +16,14 @@ def _key(s: str) -> str:
 
 
 class Progress:
-    """Progress per stage, to an optional hook (the CLI's bar) and a Prefect progress artifact."""
+    """A ``progress(stage, done, total)`` callback (``react3d_core.pipeline.ProgressFn``) that forwards to
+    an optional hook (the CLI's bar) and updates a Prefect progress artifact for the UI."""
+
+    STAGES = ("perception", "segmentation", "articulation", "assembly", "export", "report")
 
     def __init__(self, hook: Callable[[str, int, int], None] | None) -> None:
         self.hook = hook
-        self.totals: dict[str, int] = {}
-        self.done: dict[str, int] = {}
         self._artifact = None
-        self._stages = ["perception", "segmentation", "articulation", "assembly", "export", "report"]
         try:
             from prefect.artifacts import create_progress_artifact
 
@@ -31,20 +31,14 @@ class Progress:
         except Exception:  # noqa: BLE001 - outside a flow run (tests of the body) there is nothing to update
             self._artifact = None
 
-    def start(self, stage: str, total: int) -> None:
-        self.totals[stage], self.done[stage] = total, 0
+    def __call__(self, stage: str, done: int, total: int) -> None:
         if self.hook:
-            self.hook(stage, 0, total)
-
-    def advance(self, stage: str, n: int) -> None:
-        self.done[stage] = self.done.get(stage, 0) + n
-        if self.hook:
-            self.hook(stage, self.done[stage], self.totals.get(stage, 1))
-        if self._artifact is not None:
+            self.hook(stage, done, total)
+        if self._artifact is not None and done:
             from prefect.artifacts import update_progress_artifact
 
-            idx = self._stages.index(stage) if stage in self._stages else 0
-            frac = (idx + self.done[stage] / max(self.totals.get(stage, 1), 1)) / len(self._stages)
+            idx = self.STAGES.index(stage) if stage in self.STAGES else 0
+            frac = (idx + done / max(total, 1)) / len(self.STAGES)
             try:
                 update_progress_artifact(self._artifact, min(100.0, 100.0 * frac))
             except Exception:  # noqa: BLE001 - progress is cosmetic; never fail a conversion over it

@@ -18,11 +18,17 @@ from typing import Any
 from prefect import task
 
 from react3d_core.atomic import atomic_dir, check_output_dir
-from react3d_core.config import ExportConfig, PipelineConfig
+from react3d_core.config import ExportConfig
+from react3d_core.pipeline import OUTPUT_KIND, key_material, output_marker, step_config
+from react3d_core.pipeline import assemble as assemble_step
+from react3d_core.pipeline import export as export_step
+from react3d_core.pipeline.steps import copy_folder
 
-from .keys import canonical, content_key, stage_version
-from .scene import scan_mesh, scene_input
+from .keys import canonical, content_key
+from .scene import loaded_scene
 from .store import cache_root, get, relative, resolve, seal_dir
+
+__all__ = ["OUTPUT_KIND", "assemble", "export", "fill_output", "output_marker", "publish", "publish_body", "stage_output"]
 
 
 def _dir_for(stage: str, inputs: Any) -> Path:
@@ -30,63 +36,40 @@ def _dir_for(stage: str, inputs: Any) -> Path:
     return cache_root() / "scenes" / sha[:2] / f"{stage}-{sha[:32]}"
 
 
-def assemble_body(scene_path: str, scene_sha: str, frames_cfg: dict[str, Any], parts: list[dict[str, Any]],
-                  config: dict[str, Any]) -> dict[str, Any]:
-    from react3d_core.assembly import assemble_scene
-
+def assemble_body(scene_path: str, scene_sha: str, parts: list[dict[str, Any]], config: dict[str, Any]) -> dict[str, Any]:
     t0 = time.perf_counter()
-    cfg = PipelineConfig().with_overrides(config)
-    scene = scene_input(scene_path, frames_cfg)
-    versions = {m: stage_version(m) for m in ("react3d_core.articulation", "react3d_core.assembly",
-                                              "react3d_core.cavity", "react3d_core.dedup")}
-    out = _dir_for("assembly", [scene_sha, parts, config, versions])
+    loaded = loaded_scene(scene_path, config)
+    out = _dir_for("assembly", [scene_sha, parts, key_material("assembly", config)])
     arts = [get(h) for h in parts if h.get("kind") != "rejected"]
     with atomic_dir(out) as tmp:
-        assemble_scene(scene, scan_mesh(str(scene.mesh_path)), arts, cfg, tmp)
+        assemble_step(loaded, arts, config, tmp)
     seal_dir(out)  # cache hits are verified against it (tasks.store.verify_dir)
     return {"sha256": out.name, "path": relative(out / "scene.json"), "kind": "assembled-scene",
             "seconds": time.perf_counter() - t0}
 
 
-@task(name="assemble-scene", cache_key_fn=content_key("assembly", ("react3d_core.assembly", "react3d_core.cavity",
-                                                                 "react3d_core.dedup", "react3d_core.articulation")),
-      result_serializer="json", cache_result_in_memory=False)
-def assemble(scene_path: str, scene_sha: str, frames_cfg: dict[str, Any], parts: list[dict[str, Any]],
-             config: dict[str, Any]) -> dict[str, Any]:
+@task(name="assemble-scene", cache_key_fn=content_key("assembly"), result_serializer="json", cache_result_in_memory=False)
+def assemble(scene_path: str, scene_sha: str, parts: list[dict[str, Any]], config: dict[str, Any]) -> dict[str, Any]:
     """Deduplicate, add cavities and limits, carve the background; a manifest folder in the store."""
-    return assemble_body(scene_path, scene_sha, frames_cfg, parts, config)
+    return assemble_body(scene_path, scene_sha, parts, step_config("assembly", config))
 
 
-def export_body(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: list[str]) -> dict[str, Any]:
-    from react3d_core.export import export_scene
-
+def export_body(assembled: dict[str, Any], config: dict[str, Any], formats: list[str]) -> dict[str, Any]:
     t0 = time.perf_counter()
     src = resolve(assembled["path"]).parent
-    out = _dir_for("export", [assembled, export_cfg, formats, stage_version("react3d_core.export"),
-                              stage_version("react3d_core.texture")])
+    out = _dir_for("export", [assembled, formats, key_material("export", config)])
     with atomic_dir(out) as tmp:
         shutil.copytree(src, tmp, dirs_exist_ok=True)
-        export_scene(tmp / "scene.json", tuple(formats), ExportConfig.model_validate(export_cfg))
+        export_step(tmp / "scene.json", formats, ExportConfig.model_validate(config.get("export", {})))
     seal_dir(out)
     return {"sha256": out.name, "path": relative(out / "scene.json"), "kind": "exported-scene",
             "seconds": time.perf_counter() - t0}
 
 
-@task(name="export-scene", cache_key_fn=content_key("export", ("react3d_core.export", "react3d_core.texture")),
-      result_serializer="json", cache_result_in_memory=False)
-def export(assembled: dict[str, Any], export_cfg: dict[str, Any], formats: list[str]) -> dict[str, Any]:
+@task(name="export-scene", cache_key_fn=content_key("export"), result_serializer="json", cache_result_in_memory=False)
+def export(assembled: dict[str, Any], config: dict[str, Any], formats: list[str]) -> dict[str, Any]:
     """URDF / USD / MJCF with textures and collisions, in the store."""
-    return export_body(assembled, export_cfg, formats)
-
-
-OUTPUT_KIND = "scene"
-"""The ``kind`` in the marker of a conversion output (``react3d_core.atomic.OUTPUT_MARKER``)."""
-
-
-def output_marker(scene_path: str | None = None) -> dict[str, Any]:
-    """What a conversion output's marker records: that react3d wrote it, for which scan, when."""
-    return {"kind": OUTPUT_KIND, "scene": str(Path(scene_path).resolve()) if scene_path else None,
-            "created": time.strftime("%Y-%m-%dT%H:%M:%S%z")}
+    return export_body(assembled, step_config("export", config), formats)
 
 
 def fill_output(result: dict[str, Any], staging: str | Path, out_dir: str | Path,
@@ -106,26 +89,11 @@ def fill_output(result: dict[str, Any], staging: str | Path, out_dir: str | Path
     manifest = InteractiveScene.load(src / "scene.json")
     mesh = Path(scan_mesh_path) if scan_mesh_path else Path(manifest.input_mesh)
     mesh = mesh.resolve() if mesh.is_absolute() or scan_mesh_path else (src / mesh).resolve()
-    _copy_tree(src, staging)
+    copy_folder(src, staging)
     # the scan mesh stays where it is: re-point the manifest's reference from the new folder
     rel = os.path.relpath(mesh, out.resolve())
     manifest.model_copy(update={"input_mesh": rel}).save(staging / "scene.json")
     return str(staging / "scene.json")
-
-
-def _copy_tree(src: Path, dst: Path) -> None:
-    """Copy ``src`` into ``dst``, stopping at the first failure with one OSError naming the target file
-    (``shutil.copytree`` collects every failed file into one exception: 642 KB for a full disk)."""
-    for p in sorted(src.rglob("*")):
-        target = dst / p.relative_to(src)
-        try:
-            if p.is_dir():
-                target.mkdir(parents=True, exist_ok=True)
-            else:
-                target.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copy2(p, target)
-        except OSError as exc:
-            raise OSError(exc.errno, exc.strerror, str(target)) from None
 
 
 def publish_body(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None,

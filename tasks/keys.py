@@ -1,8 +1,9 @@
 """Content-based cache keys: what a task computes from, never where files happen to live.
 
-A key hashes the stage name, the stage's ``STAGE_VERSION`` (bumped when its algorithm changes; the
-task's own source is not enough because the work happens in ``react3d_core``), and the task's
-parameters with handles reduced to their content hash and path-like parameters dropped.
+A key hashes the step's identity as the stage descriptors declare it
+(:func:`react3d_core.pipeline.key_material`: versions and config sections of the step's stages and
+of every stage upstream of them) and the task's other parameters, with handles reduced to their
+content hash and path-like parameters dropped.
 """
 
 from __future__ import annotations
@@ -13,11 +14,13 @@ import json
 from collections.abc import Callable
 from typing import Any
 
-KEY_VERSION = "1"
+from react3d_core.pipeline import key_material
+
+KEY_VERSION = "2"  # 2: keys derived from the stage descriptors (issue #17)
 
 
 def stage_version(module: str) -> str:
-    """``STAGE_VERSION`` of a react3d_core stage package ("missing" if it is not installed)."""
+    """``STAGE_VERSION`` of a module outside the core stages (e.g. ``tasks.models``); "missing" if absent."""
     try:
         return str(getattr(importlib.import_module(module), "STAGE_VERSION", "0"))
     except ImportError:
@@ -35,8 +38,22 @@ def canonical(x: Any) -> Any:
     return x
 
 
-def content_key(stage: str, modules: tuple[str, ...], ignore: tuple[str, ...] = ("scene_path", "out_dir")) -> Callable[[Any, dict[str, Any]], str]:
-    """A Prefect ``cache_key_fn`` for ``stage`` whose code lives in ``modules``.
+def step_key(step: str, params: dict[str, Any], extra_versions: tuple[str, ...] = (),
+             ignore: tuple[str, ...] = ("scene_path", "out_dir")) -> str:
+    """The cache key of ``step`` called with ``params`` (its ``config`` parameter is the pipeline config,
+    of which only the sections the step declares count)."""
+    body = {
+        "key_version": KEY_VERSION,
+        **key_material(step, params.get("config") or {}),
+        "extra_versions": {m: stage_version(m) for m in extra_versions},
+        "params": {k: canonical(v) for k, v in sorted(params.items()) if k not in ignore and k != "config"},
+    }
+    return f"{step}-" + hashlib.sha256(json.dumps(body, sort_keys=True, default=str).encode()).hexdigest()[:40]
+
+
+def content_key(step: str, extra_versions: tuple[str, ...] = (),
+                ignore: tuple[str, ...] = ("scene_path", "out_dir")) -> Callable[[Any, dict[str, Any]], str]:
+    """A Prefect ``cache_key_fn`` for ``step`` (see :func:`step_key`).
 
     Defining a cached task also installs the result-record guard: a cache hit is read only from a JSON
     record whose objects verify (``tasks.prefect_env.guard_result_records``)."""
@@ -45,12 +62,6 @@ def content_key(stage: str, modules: tuple[str, ...], ignore: tuple[str, ...] = 
     guard_result_records()
 
     def key(_ctx: Any, params: dict[str, Any]) -> str:
-        body = {
-            "stage": stage,
-            "key_version": KEY_VERSION,
-            "versions": {m: stage_version(m) for m in modules},
-            "params": {k: canonical(v) for k, v in sorted(params.items()) if k not in ignore},
-        }
-        return f"{stage}-" + hashlib.sha256(json.dumps(body, sort_keys=True, default=str).encode()).hexdigest()[:40]
+        return step_key(step, params, extra_versions, ignore)
 
     return key

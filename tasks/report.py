@@ -1,51 +1,34 @@
-"""Last steps in the output folder: record config/versions/timings, evaluate against GT, write report.html."""
+"""Last steps in the output folder, around the pipeline's step functions: record config, versions and
+timings; evaluate against GT; write report.html."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any
 
 from prefect import task
 
-from react3d_core.atomic import write_json
-from react3d_core.config import PipelineConfig
-from react3d_core.data.parts import InteractiveScene
+from react3d_core.config import EvaluationConfig
+from react3d_core.pipeline import evaluate as evaluate_step
+from react3d_core.pipeline import finalize as finalize_step
+from react3d_core.pipeline import report as report_step
 
-from .scene import scene_input
+from .scene import loaded_scene
+from .store import cache_root
 
 
 def finalize_body(manifest_path: str, config: dict[str, Any], versions: dict[str, str], timings: dict[str, float]) -> str:
-    m = InteractiveScene.load(manifest_path)
-    m.model_copy(update={"config": config, "versions": {**m.versions, **versions},
-                         "timings": {**m.timings, **timings}}).save(manifest_path)
+    finalize_step(manifest_path, config, versions, timings)
     return manifest_path
 
 
 def evaluate_body(manifest_path: str, gt_dir: str, config: dict[str, Any]) -> dict[str, Any]:
     """The paper's metrics for this scene against its ground truth (per IoU threshold)."""
-    from react3d_core.ground_truth import read_articulate3d
-    from react3d_core.metrics import evaluate_scene, to_json_dict
-
-    cfg = PipelineConfig.model_validate(config)
-    pred = InteractiveScene.load(manifest_path)
-    gt = read_articulate3d(gt_dir)
-    metrics = evaluate_scene(pred, Path(manifest_path).parent, gt, cfg.evaluation)
-    out = to_json_dict([metrics])
-    write_json(Path(manifest_path).parent / "metrics.json", out)
-    return out
+    return evaluate_step(manifest_path, gt_dir, EvaluationConfig.model_validate(config.get("evaluation", {})))
 
 
-def report_body(manifest_path: str, scene_path: str, frames_cfg: dict[str, Any], metrics: dict[str, Any] | None) -> str:
-    from react3d_core.viewer import write_report
-
-    per_tau = None
-    if metrics:
-        per_tau = metrics.get("aggregate", metrics)
-    from .store import cache_root
-
+def report_body(manifest_path: str, scene_path: str, config: dict[str, Any], metrics: dict[str, Any] | None) -> str:
     # thumbnails and viewer meshes by content: a re-convert of the same scene does not redo them
-    return str(write_report(manifest_path, scene_input=scene_input(scene_path, frames_cfg), metrics=per_tau,
-                            cache_dir=cache_root() / "reports"))
+    return str(report_step(manifest_path, loaded_scene(scene_path, config).scene, metrics, cache_dir=cache_root() / "reports"))
 
 
 @task(name="evaluate-scene", persist_result=False)
@@ -54,8 +37,8 @@ def evaluate(manifest_path: str, gt_dir: str, config: dict[str, Any]) -> dict[st
 
 
 @task(name="write-report", persist_result=False)
-def report(manifest_path: str, scene_path: str, frames_cfg: dict[str, Any], metrics: dict[str, Any] | None) -> str:
-    return report_body(manifest_path, scene_path, frames_cfg, metrics)
+def report(manifest_path: str, scene_path: str, config: dict[str, Any], metrics: dict[str, Any] | None) -> str:
+    return report_body(manifest_path, scene_path, config, metrics)
 
 
 @task(name="finalize-manifest", persist_result=False)

@@ -73,13 +73,9 @@ def precheck_scene(scene: str, cfg: dict[str, Any]) -> str:
 
     prefect_env.configure()
     from react3d_core.config import PipelineConfig
-    from react3d_core.scene_io.scale import check_scale
-    from tasks.scene import scan_mesh, scene_input
+    from tasks.scene import loaded_scene
 
-    frames_cfg = PipelineConfig().with_overrides(cfg).model_dump(mode="json")["frames"]
-    loaded = scene_input(scene, frames_cfg)
-    check_scale(loaded, scan_mesh(str(loaded.mesh_path)))
-    return loaded.frame_selection
+    return loaded_scene(scene, PipelineConfig().with_overrides(cfg).model_dump(mode="json")).scene.frame_selection
 
 
 def _check_formats(formats: object) -> None:
@@ -165,9 +161,5 @@ def run_with_progress(scene: str, out: str, cfg: dict[str, Any], title: str) -> 
             bar.update(rows[stage], completed=done if total else 1, total=max(total, 1))
 
         bar.console.print(f"[dim]{title}[/dim]")
-        cs.PROGRESS_HOOK = hook
-        try:
-            with prefect_errors_to_log(log_path()):
-                return cs.convert_scene(scene, out, cfg)
-        finally:
-            cs.PROGRESS_HOOK = None
+        with prefect_errors_to_log(log_path()):
+            return cs.convert_scene(scene, out, cfg, progress=hook)

@@ -5,9 +5,11 @@ textures once in ``assets``, referenced by every format);
 ``import_urdf(path)`` reads the articulations back for round trips.
 """
 
+from ..stage import StageSpec
 from .importer import import_urdf
 from .scene import FORMATS, export_scene
 
 STAGE_VERSION = "2"  # 2: one shared asset folder, binary USD, export_sizes (issue #18)
+STAGE = StageSpec("export", __name__, STAGE_VERSION, sections=("export",), upstream=("assembly", "texture"))
 
-__all__ = ["FORMATS", "STAGE_VERSION", "export_scene", "import_urdf"]
+__all__ = ["STAGE", "FORMATS", "STAGE_VERSION", "export_scene", "import_urdf"]

@@ -5,6 +5,7 @@ Each sub-step is callable on its own (the Prefect layer lifts frames as separate
 ``clip_part``; ``segment_parts`` runs them all.
 """
 
+from ..stage import StageSpec
 from .clip import clip_part, ransac_plane
 from .connectivity import largest_component, weld_labels
 from .lift import FrameLift, fill_holes, lift_masks
@@ -14,8 +15,10 @@ from .segment import lift_frames, segment_parts
 from .topk import select_top_views
 
 STAGE_VERSION = "1"
+STAGE = StageSpec("fusion", __name__, STAGE_VERSION, sections=("fusion", "topk", "clip"), upstream=("perception",))
 
 __all__ = [
+    "STAGE",
     "STAGE_VERSION",
     "FrameLift",
     "FusionMesh",

@@ -23,8 +23,9 @@ from ..data.masks import ArticulationPrediction, Mask2D
 from ..errors import InputError
 from ..ground_truth import GroundTruth, read_articulate3d
 from .interfaces import Perception
+from .versions import ORACLE_VERSION
 
-STAGE_VERSION = "2"  # 2: says "sliding" for GT prismatic joints in the part's front plane
+STAGE_VERSION = ORACLE_VERSION  # history in react3d_core/perception/versions.py
 REF_WIDTH = 960  # pixel sizes in OracleNoiseConfig are given at this image width
 
 

@@ -4,13 +4,16 @@
 write it in the formats simulators read (see ``react3d_core.export``).
 """
 
+from ..stage import StageSpec
 from .atlas import ATLAS_FILL, cell_atlas, texture_side, xatlas_atlas
 from .bake import TexturedMesh, bake_texture, fill_gutters, rasterize_uv, sample_bilinear, vertex_color_error
 from .writers import write_glb, write_obj_folder
 
 STAGE_VERSION = "2"  # 2: texture encoder options (png level, jpg) (issue #18)
+STAGE = StageSpec("texture", __name__, STAGE_VERSION, sections=("export",), upstream=("assembly",))
 
 __all__ = [
+    "STAGE",
     "ATLAS_FILL",
     "STAGE_VERSION",
     "TexturedMesh",

@@ -10,7 +10,7 @@ from react3d_core.data.mesh import TriMesh
 from react3d_core.errors import InputError
 from tasks import serialize, store
 from tasks.keys import content_key
-from tasks.perception import split_on_oom
+from react3d_core.pipeline import split_on_oom
 from tasks.retry import TransientError, is_transient
 
 
@@ -48,34 +48,23 @@ def test_store_handles_are_content_addressed(tmp_path, monkeypatch) -> None:  # 
 
 
 def test_keys_ignore_paths_and_follow_content_and_version(monkeypatch) -> None:  # noqa: ANN001
-    import tasks.keys as keys
+    from react3d_core.config import PipelineConfig
+    from react3d_core.pipeline import stages
+    from react3d_core.stage import StageSpec
 
-    k = content_key("seg", ("react3d_core.fusion",))
+    c = PipelineConfig().model_dump(mode="json")
+    k = content_key("segmentation")
     h1 = {"sha256": "abc", "path": "/run1/x.npz"}
     h2 = {"sha256": "abc", "path": "/run2/x.npz"}
-    base = k(None, {"scene_path": "/a", "handle": h1, "config": {"fusion": {"x": 1}}})
-    assert base == k(None, {"scene_path": "/b", "handle": h2, "config": {"fusion": {"x": 1}}})
-    assert base != k(None, {"scene_path": "/a", "handle": {"sha256": "abd", "path": "/run1/x.npz"}, "config": {"fusion": {"x": 1}}})
-    assert base != k(None, {"scene_path": "/a", "handle": h1, "config": {"fusion": {"x": 2}}})
-    monkeypatch.setattr(keys, "stage_version", lambda m: "999")
-    assert base != k(None, {"scene_path": "/a", "handle": h1, "config": {"fusion": {"x": 1}}})
-
-
-def test_config_sections_isolate_stages() -> None:
-    import copy
-
-    from flows.convert_scene import ARTICULATION_KEYS, ASSEMBLY_KEYS, SEGMENTATION_KEYS, config_sections
-    from react3d_core.config import PipelineConfig
-
-    a = PipelineConfig().model_dump(mode="json")
-    b = copy.deepcopy(a)
-    b["export"]["changed"] = True
-    c = copy.deepcopy(a)
-    c["fusion"]["changed"] = True
-    for keys in (SEGMENTATION_KEYS, ARTICULATION_KEYS, ASSEMBLY_KEYS):  # export is none of their business
-        assert config_sections(a, keys) == config_sections(b, keys)
-    assert config_sections(a, SEGMENTATION_KEYS) != config_sections(c, SEGMENTATION_KEYS)
-    assert config_sections(a, ASSEMBLY_KEYS) == config_sections(c, ASSEMBLY_KEYS)
+    c2 = {**c, "fusion": {**c["fusion"], "min_cooccurrence": 99}}
+    base = k(None, {"scene_path": "/a", "handle": h1, "config": c})
+    assert base == k(None, {"scene_path": "/b", "handle": h2, "config": c})
+    assert base != k(None, {"scene_path": "/a", "handle": {"sha256": "abd", "path": "/run1/x.npz"}, "config": c})
+    assert base != k(None, {"scene_path": "/a", "handle": h1, "config": c2})
+    reg = dict(stages.all_stages())
+    reg["fusion"] = StageSpec(**{**reg["fusion"].__dict__, "version": "999"})
+    monkeypatch.setattr(stages, "all_stages", lambda: reg)
+    assert base != k(None, {"scene_path": "/a", "handle": h1, "config": c})  # a new stage version: a new key
 
 
 def test_transient_errors() -> None:
@@ -107,7 +96,7 @@ def test_oom_splits_batches() -> None:
 
 def test_openable_phrases_follow_the_paper() -> None:
     from react3d_core.config import PerceptionConfig
-    from tasks.perception import openable_phrases
+    from react3d_core.pipeline import openable_phrases
 
     assert openable_phrases(["cabinet", "refrigerator"], PerceptionConfig()) == ["cabinet door", "door", "refrigerator door"]
     assert openable_phrases([], PerceptionConfig()) == ["door"]  # 'door' is always kept

@@ -14,10 +14,11 @@ from __future__ import annotations
 from ...config import PerceptionConfig
 from ...data.frames import SceneInput
 from ..interfaces import Perception
+from ..versions import HEURISTIC_VERSION
 from .backend import (HeuristicArticulation, HeuristicModel, HeuristicPointSegmenter, HeuristicSegmenter,
                       HeuristicTagger, KeepOpenable)
 
-STAGE_VERSION = "5"  # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames; 4: sliding doors; 5: straight seams by line median, handle shadows filled, texture-adaptive clutter
+STAGE_VERSION = HEURISTIC_VERSION  # history in react3d_core/perception/versions.py
 
 
 def make_heuristic(scene: SceneInput, config: PerceptionConfig) -> Perception:

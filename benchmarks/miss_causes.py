@@ -18,7 +18,6 @@ if TYPE_CHECKING:
     from react3d_core.config import PipelineConfig
     from react3d_core.data.frames import SceneInput
     from react3d_core.data.masks import Mask2D
-    from react3d_core.data.mesh import TriMesh
     from react3d_core.ground_truth import GroundTruth
 
 
@@ -29,11 +28,6 @@ def _gt_faces(gt: GroundTruth) -> dict[int, np.ndarray]:
         f = [p.tri_indices] + [c.tri_indices for c in gt.parts if c.label.startswith(p.label + ".") and not c.movable]
         out[p.part_id] = np.unique(np.concatenate(f)).astype(np.int64)
     return out
-
-
-def _face_areas(mesh: TriMesh) -> np.ndarray:
-    t = mesh.vertices[mesh.faces]
-    return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
 
 
 def masks_on_parts_2d(scene: SceneInput, masks: Mapping[str, Sequence[Mask2D]], cfg: PipelineConfig) -> dict[int, int] | None:
@@ -71,10 +65,8 @@ def masks_on_parts_2d(scene: SceneInput, masks: Mapping[str, Sequence[Mask2D]], 
 
 def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> dict[str, Any]:
     """Causes for the conversion of ``scene_path`` (with ``config``) written to ``manifest_path``."""
-    from react3d_core.articulation import articulate_candidate
     from react3d_core.articulation.refine import is_flat
     from react3d_core.config import PipelineConfig
-    from react3d_core.data.masks import PackedMasks
     from react3d_core.data.parts import InteractiveScene
     from react3d_core.dedup import remove_duplicates
     from react3d_core.fusion.lift import filled, prepare_mask, resize_mask
@@ -83,30 +75,20 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
     from react3d_core.metrics import evaluate_scene
     from react3d_core.metrics.miss_causes import (PredictedJoint, ProposalTrace, StageOutputs, attribute_scene,
                                                  coincident_parts)
-    from tasks.perception import get_perception, perceive_body
-    from tasks.scene import rasterizer, scan_mesh, scene_input
-    from tasks.store import get
+    from react3d_core.perception import make_perception
+    from react3d_core.pipeline import articulate, load, pack_masks, perceive, view
 
     cfg = PipelineConfig().with_overrides(config)
-    c = cfg.model_dump(mode="json")
-    frames_cfg = c["frames"]
-    scene = scene_input(scene_path, frames_cfg)
+    loaded = load(scene_path, cfg.frames)
+    scene, mesh, rast = loaded.scene, loaded.mesh, loaded.raster
     if scene.gt_dir is None:
         raise ValueError(f"{scene_path}: no ground truth to attribute against")
-    mesh_path = str(scene.mesh_path)
-    mesh, rast = scan_mesh(mesh_path), rasterizer(mesh_path)
-    perc = get_perception(scene, cfg.perception)
-    res = get(perceive_body(scene_path, frames_cfg, [f.frame_id for f in scene.frames], c["perception"]), cache=False)
-    masks = PackedMasks()
-    for fid, ms in res["masks"].items():
-        masks.add(fid, ms)
+    perc = make_perception(scene, cfg.perception)
+    res = perceive(perc, scene.frames, cfg.perception)
+    masks = pack_masks([res["masks"]])
     trace = SegmentationTrace()
-    cands = segment_parts(scene, mesh, masks, perc.point_segmenter, cfg, rasterizer=rast, trace=trace)
-    parts = []
-    for cand in cands:
-        views = {v.frame_id for v in cand.top_views}
-        parts.append(articulate_candidate(scene, mesh, cand, {f: p for f, p in res["predictions"].items() if f in views},
-                                          cfg, rasterizer=rast))
+    cands = segment_parts(scene, mesh, masks, perc.point_segmenter, view(cfg, "segmentation"), rasterizer=rast, trace=trace)
+    parts = [articulate(loaded, cand, res["predictions"], cfg) for cand in cands]
     valid = [p for p in parts if p is not None]
     kept_ids = {p.candidate_id for p in remove_duplicates(valid, cfg.dedup, mesh.vertices)}
     # every frame once more at the fusion's working size: faces any frame sees, faces under each mask as predicted
@@ -135,7 +117,7 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
         validated=[p is not None for p in parts],
         kept=[k.candidate_id in kept_ids for k in cands],
         masked_2d=masks_on_parts_2d(scene, masks, cfg),
-        face_area=_face_areas(mesh),
+        face_area=mesh.face_areas,
         view_pixels=pix["raw"], filled_pixels=pix["filled"], lifted_pixels=pix["lifted"],
     )
     manifest = InteractiveScene.load(manifest_path)

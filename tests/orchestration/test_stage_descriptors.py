@@ -1,0 +1,83 @@
+"""Stage descriptors are the one place a stage's dependencies are declared (issue #17): cache keys,
+the sections a task sees and the manifest's versions all follow from them."""
+
+from __future__ import annotations
+
+import copy
+import importlib
+
+import pytest
+
+from react3d_core.config import PipelineConfig
+from react3d_core.errors import ConfigError
+from react3d_core.pipeline import stages
+from react3d_core.stage import StageSpec
+from tasks.keys import step_key
+
+BASE = PipelineConfig().model_dump(mode="json")
+H = {"sha256": "abc", "path": "objects/ab/abc.npz"}
+
+# For a field changed in each section, the steps whose key must change (written out by hand from the
+# pipeline's shape: perception -> fusion -> articulation -> dedup/cavity -> assembly -> texture/export).
+EXPECTED = {
+    "frames": {"perception", "segmentation", "articulation", "assembly", "export"},
+    "perception": {"perception", "segmentation", "articulation", "assembly", "export"},
+    "fusion": {"segmentation", "articulation", "assembly", "export"},
+    "topk": {"segmentation", "articulation", "assembly", "export"},
+    "clip": {"segmentation", "articulation", "assembly", "export"},
+    "articulation": {"articulation", "assembly", "export"},
+    "limits": {"assembly", "export"},
+    "cavity": {"assembly", "export"},
+    "dedup": {"assembly", "export"},
+    "assembly": {"assembly", "export"},
+    "export": {"export"},
+    "evaluation": set(),  # evaluation is not cached: it never changes a step's key
+}
+
+
+def _keys(config: dict) -> dict[str, str]:
+    return {step: step_key(step, {"scene_path": "/x", "handle": H, "config": config}) for step in stages.STEPS}
+
+
+@pytest.mark.parametrize("section", sorted(EXPECTED))
+def test_a_new_field_changes_exactly_its_stage_and_downstream_keys(section: str) -> None:
+    assert set(EXPECTED) == set(PipelineConfig.model_fields)  # a new section must be added here, on purpose
+    changed = copy.deepcopy(BASE)
+    changed[section]["a_field_added_later"] = 1  # what adding a field with a default does to the dumped config
+    before, after = _keys(BASE), _keys(changed)
+    assert {s for s in stages.STEPS if before[s] != after[s]} == EXPECTED[section]
+
+
+def test_declaring_a_section_in_a_descriptor_is_all_it_takes(monkeypatch) -> None:  # noqa: ANN001
+    """A stage that starts reading 'export' declares it once; its key and everything downstream follows."""
+    reg = dict(stages.all_stages())
+    reg["cavity"] = StageSpec(**{**reg["cavity"].__dict__, "sections": ("cavity", "export")})
+    monkeypatch.setattr(stages, "all_stages", lambda: reg)
+    assert "export" in stages.step_sections("assembly")
+    changed = copy.deepcopy(BASE)
+    changed["export"]["a_field_added_later"] = 1
+    before, after = _keys(BASE), _keys(changed)
+    assert {s for s in stages.STEPS if before[s] != after[s]} == {"assembly", "export"}
+
+
+def test_a_step_cannot_read_a_section_it_does_not_declare() -> None:
+    cfg = stages.view(PipelineConfig(), "segmentation")
+    assert cfg.fusion.min_cooccurrence == 3 and cfg.perception.backend  # own and upstream sections
+    with pytest.raises(ConfigError, match="'cavity'"):
+        _ = cfg.cavity
+    assert stages.step_config("perception", BASE).keys() == {"frames", "perception"}
+
+
+def test_every_stage_package_declares_itself_and_the_manifest_versions_follow() -> None:
+    reg = stages.all_stages()
+    assert list(reg) == ["frames", "perception", "fusion", "articulation", "dedup", "cavity", "assembly", "texture",
+                         "export", "viewer"]
+    for spec in reg.values():
+        mod = importlib.import_module(spec.module)
+        assert mod.STAGE is spec and spec.version == mod.STAGE_VERSION
+        assert set(spec.sections) <= set(PipelineConfig.model_fields)
+    declared = {sec for s in reg.values() for sec in s.sections}
+    assert set(PipelineConfig.model_fields) - declared == {"evaluation"}  # every cached section is keyed
+    v = stages.manifest_versions()
+    assert v["react3d_core.perception.heuristic"] == importlib.import_module("react3d_core.perception.heuristic").STAGE_VERSION
+    assert v["react3d_core.cavity"] == importlib.import_module("react3d_core.cavity").STAGE_VERSION
