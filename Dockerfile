@@ -1,5 +1,6 @@
-# REACT3D worker image: our code + CPU torch by default. Build the GPU flavour with
-#   docker build --build-arg EXTRAS=models,sim --build-arg TORCH_INDEX=https://download.pytorch.org/whl/cu124 .
+# REACT3D worker image: our code with the weight-free backends by default (no torch). Build the model
+# (GPU) flavour with the models extra, which brings torch from TORCH_INDEX:
+#   docker build --build-arg EXTRAS=models,sim,s3 --build-arg TORCH_INDEX=https://download.pytorch.org/whl/cu124 .
 FROM python:3.11-slim
 ARG EXTRAS=sim,s3
 ARG TORCH_INDEX=https://download.pytorch.org/whl/cpu
