@@ -7,6 +7,8 @@ sources share one code path; dishwasher baskets (internal sliding parts, not fro
 from __future__ import annotations
 
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from .procedural import SynthLayout
@@ -18,10 +20,29 @@ def build_scene_synthesizer(seed: int = 0, edge: float = 0.03) -> SynthLayout:
 
     from .from_urdf import build_from_urdf
 
-    scene = procedural_scenes.kitchen(seed=seed)
-    scene.zero_configurations()
-    with tempfile.TemporaryDirectory(prefix="react3d-ss-") as d:
+    with tempfile.TemporaryDirectory(prefix="react3d-ss-") as d, _asset_files_in(d):
+        scene = procedural_scenes.kitchen(seed=seed)
+        scene.zero_configurations()
         urdf = Path(d) / "kitchen.urdf"
         scene.export(str(urdf))
         layout = build_from_urdf(urdf, seed=seed, edge=edge, kind="scene-synthesizer-kitchen")
     return layout
+
+
+@contextmanager
+def _asset_files_in(folder: str) -> Iterator[None]:
+    """scene-synthesizer writes every procedural door, handle and sink mesh to a random file in a
+    hard-coded ``/tmp`` and never removes it (about 60 files per kitchen, thousands over a dataset).
+    While a kitchen is built, its files go to ``folder`` instead, which is removed with the build."""
+    from scene_synthesizer import utils
+
+    real = utils.get_random_filename
+
+    def into_folder(suffix: str, prefix: str = "", dir: str = "/tmp") -> str:  # noqa: A002 - the library's name
+        return real(suffix, prefix=prefix, dir=folder if dir == "/tmp" else dir)
+
+    utils.get_random_filename = into_folder
+    try:
+        yield
+    finally:
+        utils.get_random_filename = real
