@@ -9,7 +9,6 @@ content hash and path-like parameters dropped.
 from __future__ import annotations
 
 import hashlib
-import importlib
 import json
 from collections.abc import Callable
 from typing import Any
@@ -17,14 +16,6 @@ from typing import Any
 from react3d_core.pipeline import key_material
 
 KEY_VERSION = "2"  # 2: keys derived from the stage descriptors (issue #17)
-
-
-def stage_version(module: str) -> str:
-    """``STAGE_VERSION`` of a module outside the core stages (e.g. ``tasks.models``); "missing" if absent."""
-    try:
-        return str(getattr(importlib.import_module(module), "STAGE_VERSION", "0"))
-    except ImportError:
-        return "missing"
 
 
 def canonical(x: Any) -> Any:
@@ -38,20 +29,34 @@ def canonical(x: Any) -> Any:
     return x
 
 
-def step_key(step: str, params: dict[str, Any], extra_versions: tuple[str, ...] = (),
+ExtraVersions = Callable[[dict[str, Any]], dict[str, str]]
+"""Versions of code outside the core that a step's result depends on, given the step's config."""
+
+
+def model_backend_version(config: dict[str, Any]) -> dict[str, str]:
+    """The model backend's version, when the config uses it (its module imports nothing heavy)."""
+    if (config.get("perception") or {}).get("backend") != "models":
+        return {}
+    from tasks.models.version import STAGE_VERSION
+
+    return {"tasks.models": STAGE_VERSION}
+
+
+def step_key(step: str, params: dict[str, Any], extra_versions: ExtraVersions | None = None,
              ignore: tuple[str, ...] = ("scene_path", "out_dir")) -> str:
     """The cache key of ``step`` called with ``params`` (its ``config`` parameter is the pipeline config,
     of which only the sections the step declares count)."""
+    config = params.get("config") or {}
     body = {
         "key_version": KEY_VERSION,
-        **key_material(step, params.get("config") or {}),
-        "extra_versions": {m: stage_version(m) for m in extra_versions},
+        **key_material(step, config),
+        "extra_versions": extra_versions(config) if extra_versions else {},
         "params": {k: canonical(v) for k, v in sorted(params.items()) if k not in ignore and k != "config"},
     }
     return f"{step}-" + hashlib.sha256(json.dumps(body, sort_keys=True, default=str).encode()).hexdigest()[:40]
 
 
-def content_key(step: str, extra_versions: tuple[str, ...] = (),
+def content_key(step: str, extra_versions: ExtraVersions | None = None,
                 ignore: tuple[str, ...] = ("scene_path", "out_dir")) -> Callable[[Any, dict[str, Any]], str]:
     """A Prefect ``cache_key_fn`` for ``step`` (see :func:`step_key`).
 

@@ -17,7 +17,7 @@ from react3d_core.data.frames import SceneInput
 from react3d_core.perception.interfaces import Perception
 from react3d_core.pipeline import perceive, step_config
 
-from .keys import content_key
+from .keys import content_key, model_backend_version
 from .retry import retry_transient
 from .scene import loaded_scene
 from .store import put
@@ -56,7 +56,7 @@ def perceive_body(scene_path: str, frame_ids: list[str], config: dict[str, Any])
     return h
 
 
-@task(name="perceive-frames", cache_key_fn=content_key("perception", extra_versions=("tasks.models",)),
+@task(name="perceive-frames", cache_key_fn=content_key("perception", extra_versions=model_backend_version),
       retries=2, retry_delay_seconds=[2, 10], retry_condition_fn=retry_transient,
       result_serializer="json", cache_result_in_memory=False)
 def perceive_frames(scene_path: str, scene_sha: str, frame_ids: list[str], config: dict[str, Any]) -> dict[str, Any]:

@@ -20,8 +20,8 @@ from .options import ModelOptions, model_options
 from .runtime import ModelNeed, ModelUnavailableError, api_key, check_models_available, load_cached, resolve_device, resolve_dtype
 from .tag_filter import CachedTagFilter, chat_asker, local_lm_asker
 from .tagger import ClipTagger
+from .version import STAGE_VERSION
 
-STAGE_VERSION = "1"
 log = logging.getLogger(__name__)
 
 __all__ = ["STAGE_VERSION", "make_model_perception", "ModelOptions", "ModelUnavailableError"]

@@ -81,3 +81,20 @@ def test_every_stage_package_declares_itself_and_the_manifest_versions_follow() 
     v = stages.manifest_versions()
     assert v["react3d_core.perception.heuristic"] == importlib.import_module("react3d_core.perception.heuristic").STAGE_VERSION
     assert v["react3d_core.cavity"] == importlib.import_module("react3d_core.cavity").STAGE_VERSION
+
+
+def test_perception_keys_name_the_model_backend_only_when_it_is_used() -> None:
+    """Workers with and without torch share heuristic keys; the key never imports the model code."""
+    import subprocess
+    import sys
+
+    from tasks.keys import model_backend_version
+
+    assert model_backend_version(BASE) == {}
+    models = {**BASE, "perception": {**BASE["perception"], "backend": "models"}}
+    assert model_backend_version(models) == {"tasks.models": "1"}
+    code = ("import sys; from tasks.perception import perceive_frames; from tasks.keys import step_key; "
+            "from react3d_core.config import PipelineConfig; "
+            "step_key('perception', {'config': PipelineConfig().model_dump(mode='json')}); print('torch' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.stdout.strip().splitlines()[-1] == "False", out.stderr[-1500:]
