@@ -18,7 +18,7 @@ from .materials import STONE, WOOD
 
 KINDS = ("kitchen", "wardrobe", "dresser", "room_door", "mixed")  # the default kind is KINDS[seed % 5]
 # kinds only built when asked for (so the seed -> kind mapping of existing scenes stays as it was)
-EXTRA_KINDS = ("sliding",)
+EXTRA_KINDS = ("sliding", "large_kitchen")
 ALL_KINDS = KINDS + EXTRA_KINDS
 WALL_T = 0.12
 
@@ -88,16 +88,19 @@ def shell(m: MeshBuilder, rng: np.random.Generator, W: float, L: float, H: float
     m.edge = edge
 
 
-def _kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun], H: float) -> None:
+def _kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun], H: float,
+             max_units: int = 5, wall_p: float = 0.7, x_min: float = 0.0) -> None:
+    """A run of base units under a worktop, with wall cabinets above it ``wall_p`` of the time; the run
+    starts at least ``x_min`` along the wall (clear of another run in the corner)."""
     pal = PALETTES[int(rng.integers(len(PALETTES)))]
     handles = bool(rng.random() < 0.75)
-    x = float(rng.uniform(0.1, 0.4))
+    x = max(x_min, float(rng.uniform(0.1, 0.4)))
     D, Hb, plinth = float(rng.uniform(0.52, 0.62)), float(rng.uniform(0.78, 0.86)), 0.1
     x_start = x
     widths = []
     while True:
         w = float(rng.choice([0.4, 0.45, 0.5, 0.6, 0.6, 0.8]))
-        if x + w > length - 0.2 or len(widths) >= 5:
+        if x + w > length - 0.2 or len(widths) >= max_units:
             break
         widths.append(w)
         x += w
@@ -121,7 +124,7 @@ def _kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
         return
     b.static_box(fr.shifted(x_start, -D - 0.02), [0, 0, Hb], [total, D + 0.02, Hb + 0.03], (70, 70, 72), "countertop", material=STONE)
     z1 = Hb + 0.03
-    if rng.random() < 0.7 and H > 2.3:  # wall cabinets
+    if rng.random() < wall_p and H > 2.3:  # wall cabinets
         Dw, z0w, Hw = 0.35, Hb + 0.6, min(0.7, H - Hb - 0.7)
         x = x_start
         top_hinged = rng.random() < 0.5
@@ -184,6 +187,19 @@ def _sliding(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
     runs.append(ViewRun(fr, x0, x, 0.08, z1, depth))
 
 
+def _long_kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun],
+                  H: float, x_min: float = 0.0) -> None:
+    """A full wall of base units (up to 8) with wall cabinets over all of them: two such walls (an L)
+    hold 32-52 openable parts (42 on average over 30 seeds), like the large kitchens of real rooms (issue 16)."""
+    _kitchen(b, fr, length, rng, runs, H, max_units=8, wall_p=1.0, x_min=x_min)
+
+
+def _corner_kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun],
+                    H: float) -> None:
+    """The second leg of the L: it starts past the first leg's units in the corner (0.62 m deep at most)."""
+    _long_kitchen(b, fr, length, rng, runs, H, x_min=0.72)
+
+
 def build_room(seed: int, kind: str | None = None, edge: float = 0.03) -> SynthLayout:
     """A seeded room of the given kind (default: chosen by seed)."""
     rng = np.random.default_rng(seed)
@@ -213,6 +229,7 @@ def build_room(seed: int, kind: str | None = None, edge: float = 0.03) -> SynthL
         "room_door": [(0, _dresser), (1, _wardrobe)],
         "mixed": [(0, _kitchen), (1, _wardrobe), (3, _dresser)],
         "sliding": [(0, _sliding), (1, _dresser)],
+        "large_kitchen": [(0, _long_kitchen), (1, _corner_kitchen)],
     }[kind]
     for k, fn in plan:
         fr, length = frames[k]

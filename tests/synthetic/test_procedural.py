@@ -69,6 +69,29 @@ def test_every_kind_has_sane_joints(kind: str) -> None:
             assert p.interior_depth is not None and p.interior_depth > 0.2
 
 
+def test_large_kitchen_is_an_l_of_40_odd_parts_outside_the_seed_rotation() -> None:
+    counts = [len(build_room(seed, "large_kitchen").parts) for seed in (900, 901, 902)]
+    assert counts == [32, 51, 41]  # two full walls of base and wall units (32-52 over seeds 900-929)
+    layout = build_room(901, "large_kitchen")
+    assert len({round(r.frame.theta, 3) for r in layout.runs}) == 2  # two walls meeting in a corner
+    assert {p.label.split(".")[0] for p in layout.parts} == {"kitchen_cabinet", "wall_cabinet"}
+    assert "large_kitchen" not in KINDS  # seed -> kind of existing scenes unchanged
+    # every front opens out of its own wall's cabinets into the room (the room centre test above does
+    # not hold in an L: a door far along one leg mostly moves sideways as seen from the centre)
+    kid = layout.key_ids
+    for p in layout.parts:
+        verts = layout.mesh.vertices[np.unique(layout.mesh.faces[layout.face_keys == kid[p.key]].ravel())]
+        c0 = verts[:, :2].mean(0)
+        runs = []
+        for r in layout.runs:
+            local = np.linalg.inv(r.frame.T) @ np.r_[c0, 0.0, 1.0]
+            if r.x0 - 0.1 <= local[0] <= r.x1 + 0.1:
+                runs.append((abs(local[1]), r.frame.T[:2, :2] @ np.array([0.0, -1.0])))  # room side: -y
+        inward = min(runs, key=lambda t: t[0])[1]
+        moved = p.articulation.move(verts, 0.5 * p.articulation.upper)
+        assert (moved[:, :2].mean(0) - c0) @ inward > 0.05, p.label
+
+
 def test_gt_matches_rendered_part_ids(synthetic_scene) -> None:  # noqa: ANN001
     root = synthetic_scene(seed=0, n_frames=12)
     scene = load_scene(root)
