@@ -13,6 +13,7 @@ import cv2
 import numpy as np
 
 from ..data.parts import OBB
+from ..geometry import triangle_areas
 
 
 def min_obb(points: np.ndarray) -> OBB:
@@ -78,8 +79,7 @@ def _hull_normals(q: np.ndarray, h, max_normals: int = 48) -> np.ndarray:  # noq
     slab's box (its front and back, the sides) are the large ones."""
     n = h.equations[:, :3]
     n = n * np.where(n[:, [0]] < 0, -1.0, 1.0)  # n and -n give the same box
-    t = q[h.simplices]
-    area = np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+    area = triangle_areas(q, h.simplices)
     key, inv = np.unique(np.round(n, 3), axis=0, return_inverse=True)
     total = np.bincount(inv.ravel(), weights=area, minlength=len(key))
     return key[np.argsort(-total, kind="stable")[:max_normals]]

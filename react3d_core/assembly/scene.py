@@ -67,7 +67,7 @@ def attached_faces(mesh: TriMesh, p: ArticulatedPart, pf: PartFrame, reach: floa
     (a handle the segmentation left out), up to ``reach`` into the room."""
     own = np.zeros(mesh.n_faces, bool)
     own[p.face_ids] = True
-    c = mesh.vertices[mesh.faces].mean(1) - pf.center
+    c = mesh.face_centroids - pf.center
     a, b, d = c @ pf.u, c @ pf.v, c @ pf.n
     own |= (np.abs(a) <= pf.su / 2) & (np.abs(b) <= pf.sv / 2) & (d > -reach) & (d < pf.thickness / 2 + 0.002)
     return own

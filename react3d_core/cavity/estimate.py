@@ -25,6 +25,7 @@ import numpy as np
 from ..config import CavityConfig
 from ..data.frames import Frame
 from ..data.mesh import TriMesh
+from ..geometry import triangle_cross
 
 UP = np.array([0.0, 0.0, 1.0])  # world = scan frame, z up (data/frames.py conventions)
 
@@ -148,9 +149,8 @@ def _box(lo: np.ndarray, hi: np.ndarray, pf: PartFrame, origin: np.ndarray) -> t
     verts = origin + local @ R.T
     faces = np.array([[0, 1, 2], [1, 3, 2], [4, 6, 5], [5, 6, 7], [0, 4, 1], [1, 4, 5],
                       [2, 3, 6], [3, 7, 6], [0, 2, 4], [2, 6, 4], [1, 5, 3], [3, 5, 7]])
-    t = verts[faces]
-    nrm = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-    out = (nrm * (t.mean(1) - verts.mean(0))).sum(1) < 0  # make every face point away from the centre
+    nrm = triangle_cross(verts, faces)
+    out = (nrm * (verts[faces].mean(1) - verts.mean(0))).sum(1) < 0  # make every face point away from the centre
     faces[out] = faces[out][:, ::-1]
     return verts, faces
 

@@ -3,17 +3,33 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
+from .. import geometry
 from ..atomic import atomic_path
 from ..errors import InputError
+
+_DERIVED = ("face_cross", "face_normals", "face_areas", "face_centroids", "vertex_normals", "edge_adjacency")
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False  # shared by every caller: an in-place edit would corrupt the cache
+    return a
 
 
 @dataclass
 class TriMesh:
-    """Vertices (N,3 float64, metres), faces (M,3 int64) and vertex colours (N,3 uint8)."""
+    """Vertices (N,3 float64, metres), faces (M,3 int64) and vertex colours (N,3 uint8).
+
+    Derived geometry (``face_normals``, ``face_areas``, ``face_centroids``, ``vertex_normals``,
+    ``edge_adjacency``) is computed on first use by :mod:`react3d_core.geometry` and cached,
+    read-only; assigning ``vertices`` or ``faces`` drops the cache (editing them in place does not:
+    build a new mesh instead). Pickles and copies leave the cache out.
+    """
 
     vertices: np.ndarray
     faces: np.ndarray
@@ -31,6 +47,45 @@ class TriMesh:
                 c = c * 255.0
             self.colors = np.clip(np.round(c), 0, 255).astype(np.uint8)
         self.colors = self.colors[:, :3].reshape(-1, 3)
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name in ("vertices", "faces"):
+            for key in _DERIVED:
+                self.__dict__.pop(key, None)
+        object.__setattr__(self, name, value)
+
+    def __getstate__(self) -> dict[str, Any]:
+        return {k: v for k, v in self.__dict__.items() if k not in _DERIVED}
+
+    @cached_property
+    def face_cross(self) -> np.ndarray:
+        """(M,3) ``(v1 - v0) x (v2 - v0)``: right-hand normal times twice the area."""
+        return _frozen(geometry.triangle_cross(self.vertices, self.faces))
+
+    @cached_property
+    def face_normals(self) -> np.ndarray:
+        """(M,3) unit face normals (degenerate faces: ``geometry.NORMAL_FLOOR``)."""
+        return _frozen(geometry.unit_normals(self.face_cross))
+
+    @cached_property
+    def face_areas(self) -> np.ndarray:
+        """(M,) face areas (m^2)."""
+        return _frozen(0.5 * np.linalg.norm(self.face_cross, axis=1))
+
+    @cached_property
+    def face_centroids(self) -> np.ndarray:
+        """(M,3) face centroids (mean of the three corners)."""
+        return _frozen(self.vertices[self.faces].mean(1))
+
+    @cached_property
+    def vertex_normals(self) -> np.ndarray:
+        """(N,3) area-weighted unit vertex normals."""
+        return _frozen(geometry.vertex_normals(self.vertices, self.faces, self.face_cross))
+
+    @cached_property
+    def edge_adjacency(self) -> np.ndarray:
+        """(E,2) pairs ``i < j`` of faces sharing an edge of this mesh's own vertex ids (unwelded)."""
+        return _frozen(geometry.edge_adjacency(self.faces))
 
     @property
     def n_faces(self) -> int:

@@ -135,7 +135,7 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[Con
     if not len(f):
         return []
     tri = v[f]
-    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    n = mesh.face_cross
     keep = np.linalg.norm(n, axis=1) > 1e-15
     tri, n = tri[keep], n[keep]
     if not len(tri):

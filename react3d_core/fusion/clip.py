@@ -11,16 +11,12 @@ import numpy as np
 
 from ..config import ClipConfig
 from ..data.mesh import TriMesh
+from ..geometry import triangle_cross
 
 
 def face_geometry(mesh: TriMesh, face_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Centroids, unit normals and areas of ``face_ids``."""
-    tri = mesh.vertices[mesh.faces[face_ids]]
-    cr = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    nrm = np.linalg.norm(cr, axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        n = np.where(nrm[:, None] > 0, cr / nrm[:, None], 0.0)
-    return tri.mean(1), n, 0.5 * nrm
+    """Centroids, unit normals and areas of ``face_ids`` (the mesh's cached ones)."""
+    return mesh.face_centroids[face_ids], mesh.face_normals[face_ids], mesh.face_areas[face_ids]
 
 
 def ransac_plane(points: np.ndarray, weights: np.ndarray, config: ClipConfig, view_dir: np.ndarray | None = None) -> tuple[np.ndarray, float] | None:
@@ -36,8 +32,8 @@ def ransac_plane(points: np.ndarray, weights: np.ndarray, config: ClipConfig, vi
         sel = rng.choice(len(points), config.ransac_max_points, replace=False)
         points, weights = points[sel], weights[sel]
     idx = rng.integers(0, len(points), (config.ransac_iterations, 3))
-    a, b, c = points[idx[:, 0]], points[idx[:, 1]], points[idx[:, 2]]
-    n = np.cross(b - a, c - a)
+    a = points[idx[:, 0]]
+    n = triangle_cross(points, idx)  # the plane through each sampled triple
     ln = np.linalg.norm(n, axis=1)
     ok = ln > 1e-9
     n = n[ok] / ln[ok, None]

@@ -31,23 +31,6 @@ def welded_faces(mesh: TriMesh, weld_m: float) -> np.ndarray:
     return weld_labels(mesh.vertices, weld_m)[mesh.faces]
 
 
-def edge_adjacency(faces: np.ndarray) -> np.ndarray:
-    """(E,2) pairs of faces sharing an edge (i < j), from faces over (welded) vertex ids."""
-    m = len(faces)
-    if m == 0:
-        return np.zeros((0, 2), np.int64)
-    e = np.sort(np.stack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]], 1).reshape(-1, 2), 1)
-    fid = np.repeat(np.arange(m), 3)
-    key = e[:, 0].astype(np.int64) * (int(faces.max()) + 1) + e[:, 1]
-    order = np.argsort(key, kind="stable")
-    key, fid = key[order], fid[order]
-    same = np.nonzero(key[1:] == key[:-1])[0]
-    a, b = fid[same], fid[same + 1]
-    keep = a != b
-    pairs = np.sort(np.stack([a[keep], b[keep]], 1), 1)
-    return np.unique(pairs, axis=0) if len(pairs) else np.zeros((0, 2), np.int64)
-
-
 def face_components(wfaces: np.ndarray, face_ids: np.ndarray) -> tuple[int, np.ndarray]:
     """Connected components of the faces ``face_ids`` (shared welded vertex = connected)."""
     face_ids = np.asarray(face_ids, np.int64)
@@ -85,8 +68,7 @@ def largest_component(mesh: TriMesh, wfaces: np.ndarray, face_ids: np.ndarray, a
     if n <= 1:
         return face_ids
     tri = mesh.vertices[mesh.faces[face_ids]]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    big = int(np.argmax(np.bincount(lab, weights=area, minlength=n)))
+    big = int(np.argmax(np.bincount(lab, weights=mesh.face_areas[face_ids], minlength=n)))
     keep = lab == big
     if attach_m > 0:
         d = surface_distance(tri[keep], tri[~keep].reshape(-1, 3)).reshape(-1, 3)

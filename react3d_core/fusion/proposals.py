@@ -15,7 +15,8 @@ from scipy.spatial import cKDTree
 
 from ..config import PipelineConfig
 from ..data.mesh import TriMesh
-from .connectivity import edge_adjacency, largest_component, welded_faces
+from ..geometry import edge_adjacency
+from .connectivity import largest_component, welded_faces
 from .graph import cooccurrence, face_graph, louvain, membership
 from .lift import FrameLift
 
@@ -44,10 +45,6 @@ class FusionMesh:
         return self.mesh.n_faces
 
 
-def _centroids(mesh: TriMesh) -> np.ndarray:
-    return mesh.vertices[mesh.faces].mean(1)
-
-
 def decimate(mesh: TriMesh, target_faces: int) -> tuple[TriMesh, np.ndarray]:
     """Vertex-clustering decimation (Open3D) to about ``target_faces``; scan faces map to the
     decimated face with the nearest centroid.
@@ -58,8 +55,7 @@ def decimate(mesh: TriMesh, target_faces: int) -> tuple[TriMesh, np.ndarray]:
     """
     import open3d as o3d
 
-    tri = mesh.vertices[mesh.faces]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum()
+    area = mesh.face_areas.sum()
     voxel = float(np.sqrt(2.0 * area / max(1, target_faces)))
     m = mesh.to_open3d()
     for _ in range(3):
@@ -69,7 +65,7 @@ def decimate(mesh: TriMesh, target_faces: int) -> tuple[TriMesh, np.ndarray]:
             break
         voxel *= float(np.sqrt(n / target_faces))
     small = TriMesh(np.asarray(small.vertices), np.asarray(small.triangles))
-    _, fmap = cKDTree(_centroids(small)).query(_centroids(mesh), workers=-1)
+    _, fmap = cKDTree(small.face_centroids).query(mesh.face_centroids, workers=-1)
     return small, fmap.astype(np.int64)
 
 

@@ -116,7 +116,7 @@ def candidates_from_proposals(
     tops = top_views_from_stats([p.face_ids for p in proposals], stats, masks, mesh.n_faces, config)
     by_id = {f.frame_id: f for f in scene.frames}
     out = []
-    centroids = mesh.vertices[mesh.faces].mean(1)
+    centroids = mesh.face_centroids
     claimed = np.zeros(mesh.n_faces, bool)
     # best-seen proposals first; one mostly inside an earlier candidate would re-segment to it
     order = sorted(range(len(proposals)), key=lambda i: (-(tops[i][0].iou if tops[i] else 0.0), -len(proposals[i].face_ids)))

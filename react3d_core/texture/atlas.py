@@ -16,15 +16,6 @@ ATLAS_FILL = 0.7
 """Typical fraction of an xatlas atlas covered by charts: the texel budget is divided by it."""
 
 
-def mesh_area(vertices: np.ndarray, faces: np.ndarray) -> float:
-    """Total triangle area (m^2)."""
-    v = np.asarray(vertices, float)
-    f = np.asarray(faces, np.int64)
-    if not len(f):
-        return 0.0
-    return float(0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]), axis=1).sum())
-
-
 def texture_side(area_m2: float, config: ExportConfig) -> int:
     """Texture side from a texel budget: ``texel_per_m`` texels per metre over the surface.
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..config.export import ExportConfig
 from ..data.mesh import TriMesh
-from .atlas import cell_atlas, cell_size, cell_weights, mesh_area, texture_side, xatlas_atlas
+from .atlas import cell_atlas, cell_size, cell_weights, texture_side, xatlas_atlas
 
 _CHUNK_TEXELS = 4_000_000
 
@@ -144,7 +144,7 @@ def vertex_color_error(tm: TexturedMesh, mesh: TriMesh) -> float:
 
 def _bake_cells(mesh: TriMesh, config: ExportConfig) -> TexturedMesh:
     M = mesh.n_faces
-    mean_area = mesh_area(mesh.vertices, mesh.faces) / max(M, 1)
+    mean_area = float(mesh.face_areas.sum()) / max(M, 1)
     s = cell_size(M, mean_area, config)
     corners, W, H, cols = cell_atlas(M, s)
     slot, weights = cell_weights(s)
@@ -181,7 +181,7 @@ def _bake_cells(mesh: TriMesh, config: ExportConfig) -> TexturedMesh:
 
 
 def _bake_xatlas(mesh: TriMesh, config: ExportConfig) -> TexturedMesh:
-    side = texture_side(mesh_area(mesh.vertices, mesh.faces), config)
+    side = texture_side(float(mesh.face_areas.sum()), config)
     vmap, faces, px, W, H = xatlas_atlas(mesh.vertices, mesh.faces, side)
     colors = mesh.colors[vmap].astype(np.float32)
     img, mask = rasterize_uv(px, faces, colors[faces], W, H)

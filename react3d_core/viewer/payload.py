@@ -36,21 +36,10 @@ def decimate(mesh: TriMesh, max_faces: int) -> TriMesh:
     return TriMesh(np.asarray(pts, np.float64), np.asarray(faces, np.int64), mesh.colors[nearest])
 
 
-def vertex_normals(mesh: TriMesh) -> np.ndarray:
-    """Area-weighted vertex normals (vectorized scatter-add)."""
-    v, f = mesh.vertices, mesh.faces
-    fn = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    idx = f.ravel()
-    rep = np.repeat(fn, 3, axis=0)
-    n = np.stack([np.bincount(idx, rep[:, k], minlength=len(v)) for k in range(3)], 1)
-    norm = np.linalg.norm(n, axis=1, keepdims=True)
-    return n / np.maximum(norm, 1e-12)
-
-
 def mesh_payload(mesh: TriMesh, max_faces: int) -> dict[str, Any]:
     """Positions float32, normals int8, colours uint8, indices uint32 — base64."""
     m = decimate(mesh, max_faces)
-    n = np.clip(np.round(vertex_normals(m) * 127), -127, 127).astype(np.int8)
+    n = np.clip(np.round(m.vertex_normals * 127), -127, 127).astype(np.int8)
     return {
         "positions": _b64(m.vertices.astype(np.float32)),
         "normals": _b64(n),

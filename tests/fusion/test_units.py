@@ -25,7 +25,8 @@ from react3d_core.fusion import (
     select_top_views,
     weld_labels,
 )
-from react3d_core.fusion.connectivity import edge_adjacency, face_components
+from react3d_core.fusion.connectivity import face_components
+from react3d_core.geometry import edge_adjacency
 from react3d_core.fusion.graph import anchor_pairs, cooccurrence, face_graph
 from react3d_core.fusion.topk import frame_ious, membership_matrix
 from react3d_core.raster import Rasterizer

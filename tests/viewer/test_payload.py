@@ -10,7 +10,7 @@ import numpy as np
 
 from react3d_core.data import TriMesh
 from react3d_core.viewer import scene_payload, write_report
-from react3d_core.viewer.payload import decimate, vertex_normals
+from react3d_core.viewer.payload import decimate
 from react3d_core.viewer.thumbnails import thumbnail
 
 
@@ -27,7 +27,7 @@ def test_payload_round_trips_arrays(toy_scene):
 
 def test_vertex_normals_of_a_flat_square_point_up():
     m = TriMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]])
-    assert np.allclose(vertex_normals(m), [[0, 0, 1]] * 4)
+    assert np.allclose(m.vertex_normals, [[0, 0, 1]] * 4)
 
 
 def test_decimate_respects_budget(toy_scene):

@@ -93,7 +93,7 @@ class HeuristicModel:
         px = np.zeros(self.facets.n, np.int64)
         seen = np.zeros(self.facets.n, np.int64)
         dirs = np.zeros((self.facets.n, 3))
-        centroids = self.mesh.vertices[self.mesh.faces].mean(1)
+        centroids = self.mesh.face_centroids
         for i in idx:
             f = self.scene.frames[i]
             intr = f.intrinsics.scaled(max(1, f.intrinsics.width // 4), max(1, f.intrinsics.height // 4))

@@ -15,6 +15,7 @@ from scipy.sparse.csgraph import connected_components
 
 from ...config.perception import HeuristicConfig
 from ...data.mesh import TriMesh
+from ...geometry import edge_adjacency
 
 _DEFAULT = HeuristicConfig()  # defaults live in the config (perception.heuristic.facet_*)
 
@@ -24,25 +25,6 @@ def weld(vertices: np.ndarray, tol: float) -> np.ndarray:
     q = np.round(vertices / tol).astype(np.int64)
     _, inv = np.unique(q, axis=0, return_inverse=True)
     return inv.ravel()
-
-
-def face_normals(mesh: TriMesh) -> tuple[np.ndarray, np.ndarray]:
-    """Unit normals and areas of all faces."""
-    t = mesh.vertices[mesh.faces]
-    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-    a = np.linalg.norm(n, axis=1)
-    return n / np.maximum(a, 1e-15)[:, None], 0.5 * a
-
-
-def edge_adjacency(faces: np.ndarray) -> np.ndarray:
-    """Pairs (i, j) of faces sharing an (undirected) edge."""
-    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    e.sort(axis=1)
-    fid = np.tile(np.arange(len(faces)), 3)
-    order = np.lexsort((e[:, 1], e[:, 0]))
-    e, fid = e[order], fid[order]
-    same = (e[1:] == e[:-1]).all(1)
-    return np.stack([fid[:-1][same], fid[1:][same]], 1)
 
 
 @dataclass
@@ -64,8 +46,8 @@ def planar_facets(mesh: TriMesh, weld_m: float = _DEFAULT.facet_weld_m, max_angl
     ``perception.heuristic.facet_weld_m`` / ``facet_max_angle_deg``."""
     rep = weld(mesh.vertices, weld_m)
     faces = rep[mesh.faces]
-    normals, areas = face_normals(mesh)
-    pairs = edge_adjacency(faces)
+    normals, areas = mesh.face_normals, mesh.face_areas
+    pairs = edge_adjacency(faces, chain="corner")  # the chain order facets were always built with
     ok = (normals[pairs[:, 0]] * normals[pairs[:, 1]]).sum(1) >= np.cos(np.radians(max_angle_deg))
     p = pairs[ok]
     g = coo_matrix((np.ones(len(p)), (p[:, 0], p[:, 1])), shape=(len(faces), len(faces)))

@@ -67,13 +67,12 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
     it) where given, else towards ``cam_center``. ``glimpsed`` (default ``visible``): facets seen at
     all, for a front's thin edges and bevels."""
     fv = mesh.vertices[mesh.faces]                       # (F,3,3)
-    fc = fv.mean(1)
+    fc = mesh.face_centroids
     order = np.argsort(facets.labels, kind="stable")
     starts = np.searchsorted(facets.labels[order], np.arange(facets.n + 1))
     faces_of = lambda k: order[starts[k]:starts[k + 1]]  # noqa: E731
     fa = np.zeros((facets.n, 3))
-    _, areas = _areas(mesh)
-    np.add.at(fa, facets.labels, fc * areas[:, None])
+    np.add.at(fa, facets.labels, fc * mesh.face_areas[:, None])
     fcent = fa / np.maximum(facets.areas, 1e-15)[:, None]
 
     cands: list[Front] = []
@@ -311,12 +310,6 @@ def _drop_covered(cands: list[Front]) -> list[Front]:
         if covered < 0.5 * f.w * f.h:
             keep.append(f)
     return keep
-
-
-def _areas(mesh: TriMesh) -> tuple[np.ndarray, np.ndarray]:
-    t = mesh.vertices[mesh.faces]
-    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-    return n, 0.5 * np.linalg.norm(n, axis=1)
 
 
 def _neighbours(f: Front, cands: list[Front], r: FrontRules) -> list[tuple[Front, str]]:

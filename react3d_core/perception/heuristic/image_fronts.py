@@ -20,7 +20,6 @@ from ...config.perception import HeuristicConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
-from .facets import face_normals
 from .front_cells import Cell, CellParams, find_handles, off_background, off_threshold, split_cells
 from .fronts import Front, FrontRules, _joint, _neighbours, doors_in_rows
 from .orthophoto import ColourCalibration, Orthophoto, OrthoParams, build_orthophotos
@@ -87,7 +86,7 @@ class ImageFronts:
 def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = _H.plane_min_fragment_area) -> np.ndarray:
     """Grid pixels covered by the plane's own faces (centroids splatted, small holes closed)."""
     h, w = o.n_views.shape
-    cen = mesh.vertices[mesh.faces[o.plane.faces]].mean(1)
+    cen = mesh.face_centroids[o.plane.faces]
     c = np.floor((cen @ o.plane.u - o.u0) / o.res).astype(int)
     r = np.floor((o.v_top - cen[:, 2]) / o.res).astype(int)
     ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
@@ -143,8 +142,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                              offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h),
                              cell=params.plane_cell)
     orthos, calib = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
-    centroids = mesh.vertices[mesh.faces].mean(1)
-    normals, _ = face_normals(mesh)
+    centroids, normals = mesh.face_centroids, mesh.face_normals
     fronts: list[Front] = []
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     diffs = []

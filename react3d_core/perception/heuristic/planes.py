@@ -14,7 +14,6 @@ import numpy as np
 from scipy import ndimage
 
 from ...data.mesh import TriMesh
-from .facets import face_normals
 
 
 @dataclass
@@ -70,8 +69,7 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
     ``cam_center``). Pieces of one plane separated by more than ``cell`` become separate planes."""
     if mesh.n_faces == 0:
         return []
-    nrm, area = face_normals(mesh)
-    cen = mesh.vertices[mesh.faces].mean(1)
+    nrm, area, cen = mesh.face_normals, mesh.face_areas, mesh.face_centroids
     vert = (np.abs(nrm[:, 2]) <= max_tilt) & (area > 0)
     if not vert.any():
         return []

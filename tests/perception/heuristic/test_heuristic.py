@@ -8,7 +8,8 @@ import pytest
 from react3d_core.config import PerceptionConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.perception.heuristic import make_heuristic
-from react3d_core.perception.heuristic.facets import edge_adjacency, planar_facets
+from react3d_core.geometry import edge_adjacency
+from react3d_core.perception.heuristic.facets import planar_facets
 from react3d_core.perception.heuristic.fronts import find_fronts
 from react3d_core.perception.interfaces import ArticulationPredictor, PointPromptSegmenter, TextPromptSegmenter
 from react3d_core.scene_io import load_scene
@@ -33,7 +34,7 @@ def _cabinet() -> TriMesh:
 
 def test_edge_adjacency_hand_computed() -> None:
     faces = np.array([[0, 1, 2], [2, 1, 3], [4, 5, 6]])
-    assert sorted(tuple(sorted(p)) for p in edge_adjacency(faces).tolist()) == [(0, 1)]
+    assert sorted(tuple(sorted(p)) for p in edge_adjacency(faces, chain="corner").tolist()) == [(0, 1)]
 
 
 def _visible(mesh: TriMesh, facets) -> np.ndarray:  # noqa: ANN001
