@@ -20,8 +20,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="Output scene folder (replaced atomically).")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--source", default="procedural", choices=["procedural", "scene-synthesizer", "urdf"])
-    p.add_argument("--kind", default=None, choices=["kitchen", "wardrobe", "dresser", "room_door", "mixed", "sliding"],
-                   help="Procedural room type (default: chosen by seed; sliding = sliding-door sideboard and wardrobe, only when asked).")
+    p.add_argument("--kind", default=None, choices=["kitchen", "wardrobe", "dresser", "room_door", "mixed", "sliding", "large_kitchen"],
+                   help="Procedural room type (default: chosen by seed; only when asked: sliding = sliding-door sideboard "
+                        "and wardrobe, large_kitchen = an L of two full walls, 32-52 parts).")
     p.add_argument("--frames", type=int, default=60, help="Number of RGB-D frames to render.")
     p.add_argument("--urdf", default=None, help="Articulated URDF for --source urdf.")
     p.add_argument("--up", default="z", choices=["z", "y", "x", "-z", "-y", "-x"],
