@@ -25,7 +25,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import numpy as np  # noqa: E402
 
 from react3d_core.config import DedupConfig  # noqa: E402
-from react3d_core.dedup import dedup_indices, overlap_matrix  # noqa: E402
+from react3d_core.dedup import dedup_indices  # noqa: E402
+from react3d_core.geometry import iou_matrix  # noqa: E402
 
 
 def make_candidates(n_total: int = 200, k: int = 6, front_size: int = 1200, seed: int = 0) -> list[np.ndarray]:
@@ -70,9 +71,8 @@ def reference_stage2_one(big: np.ndarray, small: list[np.ndarray], budget_s: flo
 
 def reference_cost(sets: list[np.ndarray], cfg: DedupConfig, budget_s: float) -> dict[str, float]:
     """Extrapolated reference stage-2 time: sum over parts of (2^k - 1) x (measured seconds per subset)."""
-    inter, size = overlap_matrix(sets)
-    union = size[:, None] + size[None, :] - inter
-    iou = inter / np.maximum(union, 1e-12)
+    iou = iou_matrix(sets)
+    size = np.array([len(np.unique(s)) for s in sets], float)
     ks = [int(((iou[i] >= cfg.tau_low) & (size < size[i])).sum()) for i in range(len(sets))]
     i = int(np.argmax(ks))
     small = [sets[j] for j in np.flatnonzero((iou[i] >= cfg.tau_low) & (size < size[i]))]

@@ -4,7 +4,7 @@ Stage 1: parts whose vertex sets overlap with IoU >= tau_dup -> keep the larger.
 Stage 2: a part covered by a union of smaller parts (each with IoU >= tau_low against it) with
 IoU >= cover_iou is removed (it merged several fronts). The reference enumerated every subset of the
 smaller parts (2^n); here a greedy cover over at most ``max_candidates`` parts, largest overlap first,
-is O(n * k). Overlaps come from one sparse incidence product, not Python pairs.
+is O(n * k). Overlaps come from one sparse incidence product (``geometry.overlap_counts``), not Python pairs.
 Stage 3 (ours): a fragment — a part with >= tau_contained of its vertices inside one larger kept part —
 is removed. Distinct physical parts share at most boundary vertices, so such a part is a piece of the
 larger one (a frame or a panel of a frame-and-panel door that fusion also proposed on its own).
@@ -20,24 +20,11 @@ from collections.abc import Sequence
 from typing import TypeVar
 
 import numpy as np
-from scipy.sparse import csr_matrix
-
 from ..config import DedupConfig
 from ..data.parts import OBB
+from ..geometry import iou_from_counts, overlap_counts, vertex_iou
 
 T = TypeVar("T")
-
-
-def overlap_matrix(sets: Sequence[np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
-    """Pairwise intersection sizes (n x n, dense) and set sizes."""
-    if not sets:
-        return np.zeros((0, 0)), np.zeros(0)
-    sets = [np.unique(np.asarray(s, np.int64)) for s in sets]
-    all_ids, inv = np.unique(np.concatenate(sets), return_inverse=True)
-    rows = np.repeat(np.arange(len(sets)), [len(s) for s in sets])
-    A = csr_matrix((np.ones(len(rows)), (rows, inv)), shape=(len(sets), len(all_ids)))
-    inter = (A @ A.T).toarray()
-    return inter, np.array([len(s) for s in sets], float)
 
 
 def dedup_indices(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence[np.ndarray] | None = None,
@@ -47,9 +34,8 @@ def dedup_indices(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence
     n = len(sets)
     if n == 0:
         return []
-    inter, size = overlap_matrix(sets)
-    union = size[:, None] + size[None, :] - inter
-    iou = np.where(union > 0, inter / np.maximum(union, 1e-12), 0.0)
+    inter, size, _ = overlap_counts(sets)
+    iou = iou_from_counts(inter, size, size)
     order = np.argsort(-size, kind="stable")
     alive = np.ones(n, bool)
     for i in order:  # stage 1, larger first
@@ -70,8 +56,7 @@ def dedup_indices(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence
         best = 0.0
         for j in cand:  # greedy: add a part while it improves the union's IoU with part i
             new = np.union1d(cover, sets_u[j])
-            inter_ij = np.intersect1d(new, sets_u[i], assume_unique=True).size
-            iou_new = inter_ij / (len(new) + size[i] - inter_ij)
+            iou_new = vertex_iou(new, sets_u[i], assume_unique=True)
             if iou_new > best:
                 cover, best = new, iou_new
         if best >= cfg.cover_iou:

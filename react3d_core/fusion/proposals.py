@@ -15,7 +15,7 @@ from scipy.spatial import cKDTree
 
 from ..config import PipelineConfig
 from ..data.mesh import TriMesh
-from ..geometry import edge_adjacency
+from ..geometry import edge_adjacency, iou_matrix
 from .connectivity import largest_component, welded_faces
 from .graph import cooccurrence, face_graph, louvain, membership
 from .lift import FrameLift
@@ -80,17 +80,12 @@ def prepare_fusion_mesh(mesh: TriMesh, config: PipelineConfig) -> FusionMesh:
     return FusionMesh(small, fmap, wf, edge_adjacency(wf))
 
 
-def _distinct(comms: Sequence[np.ndarray], n: int, same: float) -> list[int]:
+def _distinct(comms: Sequence[np.ndarray], same: float) -> list[int]:
     """Indices of communities to keep: a community found again (Jaccard > ``same``) is dropped."""
     if not comms:
         return []
-    C = membership(list(comms), n)
-    inter = (C @ C.T).tocoo()
-    size = np.array([len(c) for c in comms], float)
-    jac = inter.data / (size[inter.row] + size[inter.col] - inter.data)
-    dup = (inter.row > inter.col) & (jac > same)  # later one duplicates an earlier one
-    drop = set(inter.row[dup].tolist())
-    return [i for i in range(len(comms)) if i not in drop]
+    dup = np.tril(iou_matrix(list(comms)) > same, -1).any(1)  # a later one duplicates an earlier one
+    return [i for i in range(len(comms)) if not dup[i]]
 
 
 def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineConfig, fusion_mesh: FusionMesh | None = None) -> list[Proposal]:
@@ -127,7 +122,7 @@ def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineCo
         if len(com) > fc.min_community_faces:
             kept.append((res, com))
     out: list[Proposal] = []
-    for i in _distinct([c for _, c in kept], n, fc.distinct_jaccard):
+    for i in _distinct([c for _, c in kept], fc.distinct_jaccard):
         res, com = kept[i]
         in_com = np.zeros(n, bool)
         in_com[com] = True

@@ -13,6 +13,7 @@ from ..data.frames import Frame, SceneInput
 from ..data.masks import Mask2D
 from ..data.mesh import TriMesh
 from ..data.parts import PartCandidate
+from ..geometry import overlap_counts
 from ..perception.interfaces import PointPromptSegmenter
 from ..raster import Rasterizer
 from ..raster.rasterizer import RasterResult
@@ -76,21 +77,21 @@ def _vertex_ids(mesh: TriMesh, faces: np.ndarray) -> np.ndarray:
     return np.unique(mesh.faces[faces].ravel()).astype(np.int64)
 
 
-def _duplicate(c: PartCandidate, k: PartCandidate, fc: FusionConfig) -> bool:
-    inter = len(np.intersect1d(c.vertex_ids, k.vertex_ids, assume_unique=True))
-    union = len(c.vertex_ids) + len(k.vertex_ids) - inter
-    return inter > fc.duplicate_iou * union or inter > fc.duplicate_contained * len(c.vertex_ids)
-
-
 def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh, config: FusionConfig = FusionConfig()) -> list[PartCandidate]:
     """Proposals of several Louvain resolutions often re-segment to the same part, or to a piece of
     it (seen cut off in their best view): keep the best-scored candidate, drop later ones with
     vertex IoU > ``duplicate_iou`` or > ``duplicate_contained`` of their vertices inside a kept one
     (issue 4's dedup still runs later)."""
-    kept: list[PartCandidate] = []
-    for c in sorted(cands, key=lambda c: (-c.score, -len(c.face_ids))):
-        if not any(_duplicate(c, k, config) for k in kept):
-            kept.append(c)
+    order = sorted(cands, key=lambda c: (-c.score, -len(c.face_ids)))
+    inter, size, _ = overlap_counts([c.vertex_ids for c in order])
+    union = size[:, None] + size[None, :] - inter
+    # [i, k]: candidate i duplicates k (IoU > duplicate_iou, written without the division) or lies in it
+    dup = (inter > config.duplicate_iou * union) | (inter > config.duplicate_contained * size[:, None])
+    keep: list[int] = []
+    for i in range(len(order)):
+        if not dup[i, keep].any():
+            keep.append(i)
+    kept = [order[i] for i in keep]
     for i, c in enumerate(kept):
         c.candidate_id = i
     return kept

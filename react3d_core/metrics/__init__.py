@@ -1,9 +1,9 @@
 """Evaluation protocol of the paper: vertex-IoU detection, joint type / OE / MD, cumulative MOD."""
 
+from ..geometry import iou_matrix
 from .geometry import axis_error_deg, joint_class, line_distance
 from .dirs import evaluate_dirs, find_pairs, run_evaluation
 from .gt_as_prediction import gt_to_scene
-from .matching import iou_matrix
 from .report import markdown_table, write_report
 from .scene_metrics import SceneMetrics, aggregate, evaluate_scene, evaluate_sets, summarize, to_json_dict
 

@@ -19,8 +19,8 @@ from ..data.mesh import load_mesh
 from ..data.parts import Articulation, InteractiveScene, load_vertex_ids
 from ..errors import InputError
 from ..ground_truth.articulate3d import GroundTruth
+from ..geometry import iou_matrix
 from .geometry import axis_error_deg, joint_class, line_distance
-from .matching import iou_matrix
 
 METRIC_KEYS = ("precision", "recall", "f1", "joint_acc", "md", "oe", "pdet", "m", "mo", "mod")
 

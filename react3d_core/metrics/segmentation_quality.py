@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..data.parts import PartCandidate
+from ..geometry import iou_matrix
 from ..ground_truth import GroundTruth
 
 
@@ -41,18 +42,9 @@ class SegmentationQuality:
         return float(self.iou[:, j].max()) if len(self.iou) else 0.0
 
 
-def vertex_iou_matrix(cands: Sequence[PartCandidate], parts: Mapping[int, np.ndarray]) -> np.ndarray:
-    """(n_cands, n_parts) vertex IoU, by one sparse-free pass over sorted id arrays."""
-    out = np.zeros((len(cands), len(parts)))
-    for i, c in enumerate(cands):
-        for j, v in enumerate(parts.values()):
-            inter = len(np.intersect1d(c.vertex_ids, v, assume_unique=True))
-            out[i, j] = inter / (len(c.vertex_ids) + len(v) - inter) if inter else 0.0
-    return out
-
-
 def segmentation_quality(cands: Sequence[PartCandidate], gt: GroundTruth, frames_seen: Mapping[int, int], min_frames: int = 3) -> SegmentationQuality:
     """Match candidates to movable GT parts (with their handles); eligible = seen in >= ``min_frames``."""
     parts = gt.movable_vertex_sets(include_children=True)
     ids = list(parts)
-    return SegmentationQuality(ids, vertex_iou_matrix(cands, parts), [p for p in ids if frames_seen.get(p, 0) >= min_frames])
+    iou = iou_matrix([c.vertex_ids for c in cands], list(parts.values()))
+    return SegmentationQuality(ids, iou, [p for p in ids if frames_seen.get(p, 0) >= min_frames])

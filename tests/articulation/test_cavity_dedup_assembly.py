@@ -14,7 +14,8 @@ from react3d_core.assembly.scene import _Geometry
 from react3d_core.cavity import PartFrame, base_mesh, d_hit, d_mesh, estimate_cavity
 from react3d_core.config import CavityConfig, DedupConfig, LimitConfig
 from react3d_core.data.parts import OBB, Articulation
-from react3d_core.dedup import dedup_indices, overlap_matrix
+from react3d_core.dedup import dedup_indices
+from react3d_core.geometry import overlap_counts
 from react3d_core.synthetic.builder import MeshBuilder
 
 
@@ -57,7 +58,7 @@ def test_dedup_stage1_keeps_the_larger() -> None:
     a = np.arange(100)
     b = np.arange(10, 100)       # IoU 0.9 with a
     c = np.arange(200, 260)
-    inter, size = overlap_matrix([a, b, c])
+    inter, size, _ = overlap_counts([a, b, c])
     assert inter[0, 1] == 90 and inter[0, 2] == 0 and list(size) == [100, 90, 60]
     assert dedup_indices([a, b, c], DedupConfig()) == [0, 2]
 

@@ -92,3 +92,41 @@ def test_edge_adjacency_non_manifold_chains():
 def test_edge_adjacency_ignores_a_face_welded_onto_itself():
     # after welding, a sliver can repeat a vertex: its two edges 0-1 are not a pair with itself
     assert geometry.edge_adjacency(np.array([[0, 1, 1], [1, 0, 2]])).tolist() == [[0, 1]]
+
+
+# --- vertex-set IoU ------------------------------------------------------------------------------
+
+def test_vertex_iou_hand_values():
+    assert geometry.vertex_iou(np.array([0, 1, 2, 3]), np.array([2, 3, 4])) == 2 / 5
+    assert geometry.vertex_iou(np.array([0, 0, 1]), np.array([1, 1])) == 1 / 2  # ids deduplicated
+    assert geometry.vertex_iou(np.array([7]), np.array([7])) == 1.0
+    assert geometry.vertex_iou(np.array([1, 2]), np.zeros(0, np.int64)) == 0.0
+    assert geometry.vertex_iou(np.zeros(0, np.int64), np.zeros(0, np.int64)) == 0.0  # empty vs empty: 0
+
+
+def test_iou_matrix_many_vs_many_hand_values():
+    a = [np.arange(0, 10), np.arange(5, 15), np.zeros(0, np.int64)]
+    b = [np.arange(0, 10), np.arange(20, 30), np.array([14, 14, 3])]
+    # a1 & b0 = 5..9 (5), union 0..14 (15); a1 & b2 = {14} (1), union 5..14 + 3 (11); a0 & b2 = {3}: 1/11
+    want = [[1.0, 0.0, 1 / 11], [5 / 15, 0.0, 1 / 11], [0.0, 0.0, 0.0]]
+    assert np.array_equal(geometry.iou_matrix(a, b), want)
+    inter, sa, sb = geometry.overlap_counts(a, b)
+    assert inter.tolist() == [[10, 0, 1], [5, 0, 1], [0, 0, 0]]
+    assert sa.tolist() == [10, 10, 0] and sb.tolist() == [10, 10, 2]
+
+
+def test_iou_matrix_against_itself_and_empty_inputs():
+    sets = [np.array([1, 2, 3]), np.array([3, 4]), np.array([10**12])]  # huge ids: compacted, not n columns
+    inter, size, size_b = geometry.overlap_counts(sets)
+    assert inter.tolist() == [[3, 1, 0], [1, 2, 0], [0, 0, 1]] and size.tolist() == size_b.tolist() == [3, 2, 1]
+    assert np.array_equal(geometry.iou_matrix(sets), [[1, 1 / 4, 0], [1 / 4, 1, 0], [0, 0, 1]])
+    assert geometry.iou_matrix([], sets).shape == (0, 3)
+    assert geometry.iou_matrix(sets, []).shape == (3, 0)
+    assert geometry.iou_matrix([np.zeros(0, np.int64)], [np.zeros(0, np.int64)]).tolist() == [[0.0]]
+
+
+def test_iou_matrix_agrees_with_pairwise_vertex_iou():
+    rng = np.random.default_rng(3)
+    sets = [rng.integers(0, 60, rng.integers(0, 30)) for _ in range(12)]
+    m = geometry.iou_matrix(sets[:5], sets[5:])
+    assert np.array_equal(m, [[geometry.vertex_iou(a, b) for b in sets[5:]] for a in sets[:5]])
