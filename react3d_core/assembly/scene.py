@@ -23,22 +23,17 @@ from ..data.frames import SceneInput
 from ..data.mesh import TriMesh, save_mesh
 from ..data.parts import Articulation, InteractiveObject, InteractiveScene, save_vertex_ids
 from ..dedup import remove_duplicates
+from ..raster import Rasterizer
 
 
 class _Geometry:
-    """Ray casts and closest-point distances on the scan mesh (Open3D), built once per scene."""
+    """Ray casts and closest-point distances on the scan mesh (its Rasterizer), built once per scene."""
 
     def __init__(self, mesh: TriMesh) -> None:
-        import open3d as o3d
-
-        self._o3d = o3d
-        self.scene = o3d.t.geometry.RaycastingScene()
-        self.scene.add_triangles(o3d.core.Tensor(mesh.vertices.astype(np.float32)),
-                                 o3d.core.Tensor(mesh.faces.astype(np.uint32)))
+        self.raster = Rasterizer(mesh)
 
     def cast(self, origins: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-        rays = np.concatenate([origins, dirs], 1).astype(np.float32)
-        return self.scene.cast_rays(self._o3d.core.Tensor(rays))["t_hit"].numpy()
+        return self.raster.cast_rays(origins, dirs).t
 
     def distance_excluding(self, own: np.ndarray, front: np.ndarray | None = None, n: np.ndarray | None = None,
                            behind_margin: float = 0.01, with_points: bool = False):  # noqa: ANN201
@@ -50,10 +45,10 @@ class _Geometry:
         closest points (the sweep checks whether the part moves into them or only past them)."""
 
         def dist(points: np.ndarray) -> np.ndarray:
-            ans = self.scene.compute_closest_points(self._o3d.core.Tensor(np.asarray(points, np.float32)))
-            cp = ans["points"].numpy().astype(float)
+            cp, face, _ = self.raster.closest_points(points)
+            cp = cp.astype(float)
             d = np.linalg.norm(cp - points, axis=1)
-            skip = own[ans["primitive_ids"].numpy().astype(np.int64)]
+            skip = own[face]
             if front is not None and n is not None:
                 skip |= (cp - front) @ n > -behind_margin
             d = np.where(skip, np.inf, d)

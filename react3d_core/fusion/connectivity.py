@@ -12,6 +12,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ..data.mesh import TriMesh
+from ..raster import Rasterizer
 
 
 def weld_labels(vertices: np.ndarray, weld_m: float) -> np.ndarray:
@@ -47,14 +48,9 @@ def face_components(wfaces: np.ndarray, face_ids: np.ndarray) -> tuple[int, np.n
 
 
 def surface_distance(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Exact distance from each point to the surface of ``triangles`` (T,3,3), Open3D/Embree."""
-    import open3d as o3d
-
-    scene = o3d.t.geometry.RaycastingScene()
-    v = np.ascontiguousarray(triangles.reshape(-1, 3), np.float32)
-    f = np.arange(len(v), dtype=np.uint32).reshape(-1, 3)
-    scene.add_triangles(o3d.core.Tensor(v), o3d.core.Tensor(f))
-    return scene.compute_distance(o3d.core.Tensor(np.ascontiguousarray(points, np.float32))).numpy()
+    """Exact distance from each point to the surface of ``triangles`` (T,3,3) (Rasterizer, Embree)."""
+    v = triangles.reshape(-1, 3)
+    return Rasterizer(TriMesh(v, np.arange(len(v)).reshape(-1, 3))).distance(points)
 
 
 def largest_component(mesh: TriMesh, wfaces: np.ndarray, face_ids: np.ndarray, attach_m: float = 0.0) -> np.ndarray:

@@ -3,6 +3,10 @@
 Ray casting is exact for any principal point and image size: a pixel (u, v) looks along
 K^-1 [u, v, 1], so there is no projection-matrix sign convention to get wrong (the reference's
 OpenGL path had a principal-point sign error). ``depth`` is the z-depth along the optical axis.
+
+:class:`Rasterizer` is the project's one entry point to ray casting: besides frame buffers it casts
+arbitrary rays (:meth:`Rasterizer.cast_rays`: distance, face, barycentric uv, face normal) and
+answers closest-point and distance queries on the same BVH.
 """
 
 from __future__ import annotations
@@ -16,6 +20,27 @@ from ..data.frames import Frame, Intrinsics
 from ..data.mesh import TriMesh
 
 INVALID = -1
+
+
+@dataclass
+class RayHits:
+    """First hits of a batch of rays, shaped like the rays' leading axes. ``t`` float32 is in units of
+    the direction's length (inf: no hit); ``face_ids`` int64 (-1: no hit); ``uvs`` float32 (..., 2)
+    barycentric coordinates of the hit in its face; ``normals`` float32 (..., 3) the hit face's normal."""
+
+    t: np.ndarray
+    face_ids: np.ndarray
+    uvs: np.ndarray
+    normals: np.ndarray
+
+
+def pixel_rays(K: np.ndarray, c2w: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """Camera centre (float32, (3,)) and per-pixel world directions (H, W, 3) through pixel centres
+    (integer coordinates), K^-1 [u, v, 1] rotated to the world: not normalised, so a hit's ``t`` is its
+    z-depth."""
+    u, v = np.meshgrid(np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32))
+    dc = np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1], np.ones_like(u)], -1)
+    return c2w[:3, 3].astype(np.float32), dc @ c2w[:3, :3].astype(np.float32).T
 
 
 @dataclass
@@ -39,21 +64,43 @@ class Rasterizer:
         ft = o3d.core.Tensor(np.ascontiguousarray(mesh.faces, dtype=np.uint32))
         self._scene.add_triangles(vt, ft)
 
-    def render(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int, frame_id: str = "") -> RasterResult:
-        """Render one view; ``K`` is for a ``width`` x ``height`` image."""
+    def cast_rays(self, origins: np.ndarray, directions: np.ndarray) -> RayHits:
+        """First hit along each ray (origins and directions (..., 3), cast to float32; directions need
+        not be unit: ``t`` is in units of their length)."""
         import open3d as o3d
 
-        u, v = np.meshgrid(np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32))
-        dc = np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1], np.ones_like(u)], -1)
-        R = c2w[:3, :3].astype(np.float32)
-        dw = dc @ R.T  # not normalised: t_hit is then the z-depth directly
-        rays = np.concatenate([np.broadcast_to(c2w[:3, 3].astype(np.float32), dw.shape), dw], -1)
+        o = np.asarray(origins, np.float32)
+        d = np.asarray(directions, np.float32)
+        shape = np.broadcast_shapes(o.shape, d.shape)[:-1]
+        rays = np.concatenate([np.broadcast_to(o, shape + (3,)), np.broadcast_to(d, shape + (3,))], -1)
         ans = self._scene.cast_rays(o3d.core.Tensor(np.ascontiguousarray(rays.reshape(-1, 6), dtype=np.float32)))
-        t = ans["t_hit"].numpy().reshape(height, width)
-        ids = ans["primitive_ids"].numpy().reshape(height, width).astype(np.int64)
-        hit = np.isfinite(t)
-        face_ids = np.where(hit, ids, INVALID).astype(np.int32)
-        depth = np.where(hit, t, 0.0).astype(np.float32)
+        t = ans["t_hit"].numpy().reshape(shape)
+        ids = ans["primitive_ids"].numpy().astype(np.int64).reshape(shape)
+        ids[~np.isfinite(t)] = INVALID
+        return RayHits(t, ids, ans["primitive_uvs"].numpy().reshape(shape + (2,)),
+                       ans["primitive_normals"].numpy().reshape(shape + (3,)))
+
+    def closest_points(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Closest surface point (float32 (N,3)), its face (int64) and barycentric uv (float32 (N,2))
+        for each of ``points`` (N,3)."""
+        import open3d as o3d
+
+        ans = self._scene.compute_closest_points(o3d.core.Tensor(np.ascontiguousarray(points, np.float32)))
+        return ans["points"].numpy(), ans["primitive_ids"].numpy().astype(np.int64), ans["primitive_uvs"].numpy()
+
+    def distance(self, points: np.ndarray) -> np.ndarray:
+        """Distance (float32) from each of ``points`` (N,3) to the surface."""
+        import open3d as o3d
+
+        return self._scene.compute_distance(o3d.core.Tensor(np.ascontiguousarray(points, np.float32))).numpy()
+
+    def render(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int, frame_id: str = "") -> RasterResult:
+        """Render one view; ``K`` is for a ``width`` x ``height`` image."""
+        origin, dirs = pixel_rays(K, c2w, width, height)
+        hits = self.cast_rays(origin, dirs)
+        hit = np.isfinite(hits.t)
+        face_ids = np.where(hit, hits.face_ids, INVALID).astype(np.int32)
+        depth = np.where(hit, hits.t, 0.0).astype(np.float32)
         return RasterResult(frame_id, face_ids, depth)
 
     def render_frame(self, frame: Frame, intrinsics: Intrinsics | None = None) -> RasterResult:
@@ -71,11 +118,5 @@ class Rasterizer:
 
     def first_hit(self, origins: np.ndarray, directions: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Distance along (unit) rays to the first hit (inf if none) and the face id (-1 if none)."""
-        import open3d as o3d
-
-        rays = np.concatenate([np.asarray(origins, np.float32), np.asarray(directions, np.float32)], -1)
-        ans = self._scene.cast_rays(o3d.core.Tensor(np.ascontiguousarray(rays.reshape(-1, 6), dtype=np.float32)))
-        t = ans["t_hit"].numpy()
-        ids = ans["primitive_ids"].numpy().astype(np.int64)
-        ids[~np.isfinite(t)] = INVALID
-        return t, ids
+        hits = self.cast_rays(origins, directions)
+        return hits.t, hits.face_ids

@@ -27,6 +27,7 @@ import numpy as np
 
 from ..data.parts import Articulation
 from ..errors import InputError
+from ..raster import Rasterizer
 from .builder import MeshBuilder, bisect_to_size
 from .furniture import PartSpec, WallFrame
 from .materials import GLOSSY, MATTE, METAL, WOOD
@@ -203,10 +204,7 @@ def build_from_urdf(path: Path, seed: int = 0, edge: float = 0.03, kind: str = "
 
 def _runs(mesh, keys, key_ids, parts: list[PartSpec], W: float, L: float) -> list[ViewRun]:  # noqa: ANN001
     """One camera run per group of fronts that open towards the same side (nearest of 4 directions)."""
-    import open3d as o3d
-
-    scene = o3d.t.geometry.RaycastingScene()  # built once for every run's free-depth probe
-    scene.add_triangles(o3d.core.Tensor(mesh.vertices.astype(np.float32)), o3d.core.Tensor(mesh.faces.astype(np.uint32)))
+    raster = Rasterizer(mesh)  # built once for every run's free-depth probe
     groups: dict[int, list[np.ndarray]] = {}
     for p in parts:
         sel = keys == key_ids[p.key]
@@ -232,23 +230,20 @@ def _runs(mesh, keys, key_ids, parts: list[PartSpec], W: float, L: float) -> lis
         loc = loc - np.array([0.0, y_front, 0.0])
         c = np.concatenate(vs).mean(0)
         free = min({0: W - c[0], 1: L - c[1], 2: c[0], 3: c[1]}[k],
-                   _free_depth(scene, fr, float(loc[:, 0].min()), float(loc[:, 0].max()), out))
+                   _free_depth(raster, fr, float(loc[:, 0].min()), float(loc[:, 0].max()), out))
         runs.append(ViewRun(fr, float(loc[:, 0].min()), float(loc[:, 0].max()), float(loc[:, 2].min()),
                             float(loc[:, 2].max()), 0.0, float(free)))
     return runs
 
 
-def _free_depth(scene, fr: WallFrame, x0: float, x1: float, out: np.ndarray) -> float:  # noqa: ANN001
-    """Free distance in front of a run at camera heights (``scene``: Open3D raycasting scene of the
-    layout): furniture facing it across an aisle (an island facing a counter) must not hide the fronts
-    from the cameras meant to film them."""
-    import open3d as o3d
-
+def _free_depth(raster: Rasterizer, fr: WallFrame, x0: float, x1: float, out: np.ndarray) -> float:
+    """Free distance in front of a run at camera heights (``raster``: the layout's ray caster):
+    furniture facing it across an aisle (an island facing a counter) must not hide the fronts from
+    the cameras meant to film them."""
     T = fr.T
     xs = np.linspace(x0, x1, 7)
     starts = np.array([T[:3, :3] @ np.array([x, -0.05, z]) + T[:3, 3] for x in xs for z in (1.0, 1.3, 1.6)])
     d = np.array([out[0], out[1], 0.0])
-    rays = np.concatenate([starts, np.broadcast_to(d, starts.shape)], 1).astype(np.float32)
-    t = scene.cast_rays(o3d.core.Tensor(rays))["t_hit"].numpy()
+    t = raster.cast_rays(starts, np.broadcast_to(d, starts.shape)).t
     t = t[np.isfinite(t)]
     return float(np.median(t)) + 0.05 if len(t) else np.inf

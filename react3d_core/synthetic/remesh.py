@@ -34,6 +34,7 @@ import cv2
 import numpy as np
 
 from ..data.mesh import TriMesh
+from ..raster import Rasterizer
 from ..ground_truth.articulate3d import GTPart
 
 MESH_KINDS = ("clean", "laser", "tsdf")
@@ -162,18 +163,12 @@ class Transfer:
 
 def transfer_labels(src: TriMesh, src_face_label: np.ndarray, dst: TriMesh, radius: float = TRANSFER_RADIUS) -> Transfer:
     """Move per-face labels of ``src`` to the vertices and faces of ``dst`` (see module doc)."""
-    import open3d as o3d
-
-    scene = o3d.t.geometry.RaycastingScene()
-    scene.add_triangles(o3d.core.Tensor(src.vertices.astype(np.float32)), o3d.core.Tensor(src.faces.astype(np.uint32)))
     q = dst.vertices.astype(np.float32)
-    ans = scene.compute_closest_points(o3d.core.Tensor(q))
-    prim = ans["primitive_ids"].numpy().astype(np.int64)
-    dist = np.linalg.norm(ans["points"].numpy() - q, axis=1)
+    points, prim, uv = Rasterizer(src).closest_points(q)
+    dist = np.linalg.norm(points - q, axis=1)
     lab = np.where(dist <= radius, np.asarray(src_face_label)[prim], -1)
     a, b, c = (lab[dst.faces[:, k]] for k in range(3))
     flab = np.where((a == b) | (a == c), a, np.where(b == c, b, -1))
-    uv = ans["primitive_uvs"].numpy()
     tri = src.faces[prim]
     cs = src.colors.astype(np.float64)
     col = cs[tri[:, 0]] * (1 - uv[:, :1] - uv[:, 1:]) + cs[tri[:, 1]] * uv[:, :1] + cs[tri[:, 2]] * uv[:, 1:]

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..data.mesh import TriMesh
+from ..raster import Rasterizer, pixel_rays
 
 RGB_SIZE = (960, 720)
 DEPTH_SIZE = (256, 192)
@@ -35,36 +36,23 @@ def scale_K(K: np.ndarray, width: int) -> np.ndarray:
 
 @dataclass
 class RayCaster:
-    """Open3D ray casting over one mesh (built once, reused for all frames)."""
+    """Per-pixel hits on one mesh (its :class:`~react3d_core.raster.Rasterizer`, built once, reused for
+    all frames) and the colours shaded from them."""
 
     mesh: TriMesh
 
     def __post_init__(self) -> None:
-        import open3d as o3d
-
-        self._scene = o3d.t.geometry.RaycastingScene()
-        self._scene.add_triangles(o3d.core.Tensor(self.mesh.vertices.astype(np.float32)),
-                                  o3d.core.Tensor(self.mesh.faces.astype(np.uint32)))
+        self._raster = Rasterizer(self.mesh)
         self._colors = self.mesh.colors.astype(np.float32)
 
     def cast(self, K: np.ndarray, c2w: np.ndarray, width: int, height: int) -> dict[str, np.ndarray]:
         """Per pixel: z-depth (inf = miss), face id (-1), barycentric uv, unit ray direction, face normal,
         world hit point (0 where nothing is hit)."""
-        import open3d as o3d
-
-        # same pixel convention as react3d_core.raster.Rasterizer: integer pixel coordinates are centres
-        u, v = np.meshgrid(np.arange(width, dtype=np.float32), np.arange(height, dtype=np.float32))
-        dc = np.stack([(u - K[0, 2]) / K[0, 0], (v - K[1, 2]) / K[1, 1], np.ones_like(u)], -1)
-        dw = dc @ c2w[:3, :3].T.astype(np.float32)
-        rays = np.concatenate([np.broadcast_to(c2w[:3, 3].astype(np.float32), dw.shape), dw], -1)
-        ans = self._scene.cast_rays(o3d.core.Tensor(np.ascontiguousarray(rays.reshape(-1, 6), dtype=np.float32)))
-        t = ans["t_hit"].numpy().reshape(height, width)
-        ids = ans["primitive_ids"].numpy().astype(np.int64).reshape(height, width)
-        hit = np.isfinite(t)
-        ids[~hit] = -1
-        point = np.where(hit[..., None], c2w[:3, 3].astype(np.float32) + np.where(hit, t, 0.0)[..., None] * dw, 0.0)
-        return {"depth": t, "face": ids, "uv": ans["primitive_uvs"].numpy().reshape(height, width, 2),
-                "normal": ans["primitive_normals"].numpy().reshape(height, width, 3),
+        origin, dw = pixel_rays(K, c2w, width, height)  # the Rasterizer's pixel convention
+        h = self._raster.cast_rays(origin, dw)
+        hit = np.isfinite(h.t)
+        point = np.where(hit[..., None], origin + np.where(hit, h.t, 0.0)[..., None] * dw, 0.0)
+        return {"depth": h.t, "face": h.face_ids, "uv": h.uvs, "normal": h.normals,
                 "dir": dw / np.linalg.norm(dw, axis=-1, keepdims=True), "point": point.astype(np.float32)}
 
     def rgb(self, hit: dict[str, np.ndarray], rng: np.random.Generator) -> np.ndarray:

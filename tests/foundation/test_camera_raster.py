@@ -90,3 +90,25 @@ def test_raster_face_ids_match_centroid_projection(size: tuple[int, int]) -> Non
     Kbad = K.K.copy(); Kbad[0, 2] = K.width - K.cx
     bad = Rasterizer(mesh).render(Kbad, c2w, K.width, K.height)
     assert (bad.face_ids[px[vis, 1], px[vis, 0]] == vis).mean() < 0.5
+
+
+def test_rasterizer_cast_rays_closest_points_and_distance_hand_computed() -> None:
+    # unit square in z = 0 (two faces, normal +z); rays shaped (2, 2, 3) keep their leading axes
+    mesh = TriMesh([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], [[0, 1, 2], [0, 2, 3]])
+    r = Rasterizer(mesh)
+    o = np.array([[[0.75, 0.25, 2.0], [0.25, 0.75, 2.0]], [[0.5, 0.5, -1.0], [3.0, 3.0, 1.0]]])
+    d = np.array([[[0, 0, -1.0], [0, 0, -2.0]], [[0, 0, 1.0], [0, 0, -1.0]]])
+    h = r.cast_rays(o, d)
+    assert h.t.shape == (2, 2) and h.uvs.shape == (2, 2, 2) and h.normals.shape == (2, 2, 3)
+    # t is in units of the direction's length: 2 m down a unit ray, 1 step of a 2 m one
+    assert np.allclose(h.t[0], [2.0, 1.0]) and h.t[1, 0] == pytest.approx(1.0) and np.isinf(h.t[1, 1])
+    assert h.face_ids.tolist() == [[0, 1], [h.face_ids[1, 0], -1]] and h.face_ids[1, 0] in (0, 1)
+    assert np.allclose(h.normals[0], [[0, 0, 1], [0, 0, 1]])
+    # (0.75, 0.25) in face (0, 1, 2): barycentric weights 0.25, 0.5, 0.25 -> uv of corners 1 and 2
+    assert np.allclose(h.uvs[0, 0], [0.5, 0.25])
+    t, ids = r.first_hit(o[0], d[0])
+    assert np.allclose(t, [2.0, 1.0]) and ids.tolist() == [0, 1]
+    p = np.array([[0.25, 0.75, 0.3], [2.0, 0.5, 0.0]])
+    cp, face, _ = r.closest_points(p)
+    assert np.allclose(cp, [[0.25, 0.75, 0.0], [1.0, 0.5, 0.0]]) and face[0] == 1
+    assert np.allclose(r.distance(p), [0.3, 1.0])
