@@ -7,6 +7,22 @@ import numpy as np
 # OpenGL camera (x right, y up, z backward) <-> OpenCV camera (x right, y down, z forward).
 GL_TO_CV = np.diag([1.0, -1.0, -1.0, 1.0])
 
+K_SIZE = (1920, 1440)
+"""Image size (width, height) the iPhone / ScanNet++ intrinsics are given at (pose_intrinsic_imu.json)."""
+
+REF_WIDTH = 960
+"""Pixel sizes in the config (mask areas, erosion, borders, oracle mask noise) are given at this width."""
+
+
+def scaled_px(px: int | float, width: int) -> int:
+    """A pixel length given at ``REF_WIDTH``, for an image ``width`` wide."""
+    return int(round(px * width / REF_WIDTH))
+
+
+def scaled_area_px(px: int | float, width: int) -> float:
+    """A pixel area given at ``REF_WIDTH``, for an image ``width`` wide."""
+    return px * (width / REF_WIDTH) ** 2
+
 
 def project(points_world: np.ndarray, K: np.ndarray, w2c: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Project world points to pixel coordinates (u right, v down; pixel centres at integers).

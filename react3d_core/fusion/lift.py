@@ -9,17 +9,10 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
+from ..camera import scaled_area_px, scaled_px
 from ..config import PipelineConfig
 from ..data.masks import Mask2D
 from ..raster.rasterizer import RasterResult
-
-REF_WIDTH = 960  # pixel thresholds in the config are given at this image width
-
-
-def scaled_px(px: int | float, width: int) -> int:
-    """A pixel size given at 960 px width, for an image ``width`` wide."""
-    return int(round(px * width / REF_WIDTH))
-
 
 def fill_holes(mask: np.ndarray, close_px: int) -> np.ndarray:
     """Close gaps up to ``close_px`` (at 960 px width) then fill enclosed holes.
@@ -132,7 +125,7 @@ def lift_with_stats(raster: RasterResult, masks: Sequence[Mask2D], config: Pipel
             lift.face_sets.append(f.astype(np.int64))
             lift.mask_index.append(i)
         area = int(full.sum())
-        if area < config.topk.min_mask_px * (full.shape[1] / REF_WIDTH) ** 2:
+        if area < scaled_area_px(config.topk.min_mask_px, full.shape[1]):
             continue
         mf, mc = _histogram(ids[filled_m])
         stats.mask_index.append(i)

@@ -19,11 +19,11 @@ from ..data.mesh import TriMesh
 from ..data.parts import TopView
 from ..errors import InputError
 from ..perception.interfaces import PointPromptSegmenter
-from ..camera import project
+from ..camera import project, scaled_px
 from ..raster import Rasterizer
 from ..raster.rasterizer import RasterResult
 from .connectivity import largest_component
-from .lift import erode, fill_holes, resize_mask, scaled_px
+from .lift import erode, fill_holes, resize_mask
 
 
 def point_prompts(silhouette: np.ndarray, n_pos: int = 3, n_neg: int = 4) -> tuple[np.ndarray, np.ndarray]:

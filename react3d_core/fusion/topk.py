@@ -12,17 +12,18 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from scipy import sparse
 
+from ..camera import scaled_area_px, scaled_px
 from ..config import PipelineConfig
 from ..data.masks import Mask2D
 from ..data.parts import TopView
 from ..raster.rasterizer import RasterResult
-from .lift import REF_WIDTH, ViewStats, lift_with_stats, scaled_px
+from .lift import ViewStats, lift_with_stats
 
 
 def big_enough(mask: Mask2D, config: PipelineConfig) -> bool:
     """At least ``min_mask_px`` pixels (an area at 960 px width)."""
     m = mask.mask
-    return bool(m.any()) and m.sum() >= config.topk.min_mask_px * (m.shape[1] / REF_WIDTH) ** 2
+    return bool(m.any()) and m.sum() >= scaled_area_px(config.topk.min_mask_px, m.shape[1])
 
 
 def touches_border(mask: Mask2D, config: PipelineConfig) -> bool:

@@ -17,6 +17,7 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
+from ..camera import scaled_px
 from ..config import OracleNoiseConfig, PerceptionConfig
 from ..data.frames import Frame, SceneInput
 from ..data.masks import ArticulationPrediction, Mask2D
@@ -26,7 +27,6 @@ from .interfaces import Perception
 from .versions import ORACLE_VERSION
 
 STAGE_VERSION = ORACLE_VERSION  # history in react3d_core/perception/versions.py
-REF_WIDTH = 960  # pixel sizes in OracleNoiseConfig are given at this image width
 
 
 def _disk(r: int) -> np.ndarray:
@@ -148,7 +148,7 @@ class OracleModel:
 
     def boundary(self, mask: np.ndarray) -> np.ndarray:
         """Dilate (>0) or erode (<0) by ``boundary_px`` scaled to the image width."""
-        r = int(round(abs(self.noise.boundary_px) * mask.shape[1] / REF_WIDTH))
+        r = scaled_px(abs(self.noise.boundary_px), mask.shape[1])
         if r == 0 or not mask.any():
             return mask
         op = cv2.dilate if self.noise.boundary_px > 0 else cv2.erode

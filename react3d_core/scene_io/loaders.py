@@ -16,7 +16,7 @@ import cv2
 from PIL import Image as PILImage
 import numpy as np
 
-from ..camera import nerfstudio_scannetpp_to_c2w, opengl_to_opencv_c2w
+from ..camera import K_SIZE, nerfstudio_scannetpp_to_c2w, opengl_to_opencv_c2w
 from ..config.frames import FrameSelectionConfig
 from ..data.frames import Frame, ImageRef, Intrinsics, SceneInput, validate_pose
 from ..errors import InputError
@@ -25,7 +25,6 @@ from .depth_bin import DepthBin
 from .images import check_jpeg_complete, depth_size_problem
 from .selection import FrameSelection, choose_frames
 
-SCANNETPP_K_SIZE = (1920, 1440)
 DEPTH_SIZE = (256, 192)
 
 
@@ -175,7 +174,7 @@ def _load_iphone(root: Path) -> SceneInput:
         entry = meta[key]
         if not isinstance(entry, dict) or "intrinsic" not in entry or "aligned_pose" not in entry:
             raise InputError(meta_path, f"{key}: missing 'intrinsic' or 'aligned_pose'")
-        K = _intrinsics(meta_path, key, entry["intrinsic"], *SCANNETPP_K_SIZE).scaled(w, h)
+        K = _intrinsics(meta_path, key, entry["intrinsic"], *K_SIZE).scaled(w, h)
         pose = _check_pose(meta_path, key, entry["aligned_pose"])
         if use_mkv:
             rgb = ImageRef(path=mkv, kind="mkv", index=n)
@@ -219,7 +218,7 @@ def _load_prepared(root: Path) -> SceneInput:
             continue  # the prepared layout keeps only a subset of the json frames
         size = size or _image_size(p)
         entry = meta[key]
-        K = _intrinsics(meta_path, key, entry["intrinsic"], *SCANNETPP_K_SIZE).scaled(*size)
+        K = _intrinsics(meta_path, key, entry["intrinsic"], *K_SIZE).scaled(*size)
         d = root / "depth" / f"{key}.png"
         if d.is_file():
             _check_depth_png(d, key, DEPTH_SIZE)

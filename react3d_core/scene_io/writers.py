@@ -13,12 +13,10 @@ import cv2
 import numpy as np
 
 from ..atomic import atomic_path, write_json
-from ..camera import opencv_to_opengl_c2w
+from ..camera import K_SIZE, opencv_to_opengl_c2w
 from ..data.frames import SceneInput
 from .depth_bin import write_depth_bin
 from .images import read_depth, read_rgb
-
-K_SIZE = (1920, 1440)
 
 
 def _write_image(path: Path, rgb: np.ndarray) -> None:

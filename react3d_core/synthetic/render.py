@@ -13,12 +13,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..camera import K_SIZE
 from ..data.mesh import TriMesh
 from ..raster import Rasterizer, pixel_rays
 
 RGB_SIZE = (960, 720)
 DEPTH_SIZE = (256, 192)
-K_SIZE = (1920, 1440)
 
 
 def base_intrinsics(rng: np.random.Generator) -> np.ndarray:
