@@ -38,6 +38,20 @@ def unit_normals(cross: np.ndarray) -> np.ndarray:
     return cross / np.maximum(np.linalg.norm(cross, axis=1), NORMAL_FLOOR)[:, None]
 
 
+def horizontal_right(n: np.ndarray) -> np.ndarray:
+    """Unit ``z x n``: the horizontal axis to the right of a viewer facing a vertical surface whose
+    (horizontal) normal ``n`` points back at them (z up)."""
+    u = np.cross([0.0, 0.0, 1.0], n)
+    return u / np.linalg.norm(u)
+
+
+def concat_meshes(pieces: Sequence[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
+    """One (vertices, faces) from pieces ``(vertices_i, faces_i)``, each piece's faces offset past the
+    vertices before it."""
+    offsets = np.cumsum([0] + [len(v) for v, _ in pieces[:-1]])
+    return np.concatenate([v for v, _ in pieces]), np.concatenate([f + o for (_, f), o in zip(pieces, offsets)])
+
+
 def vertex_normals(vertices: np.ndarray, faces: np.ndarray, cross: np.ndarray | None = None) -> np.ndarray:
     """(N,3) area-weighted unit vertex normals (sum of the adjacent faces' cross products);
     ``cross`` (optional) is :func:`triangle_cross` already computed."""

@@ -22,10 +22,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..camera import unproject
 from ..config import CavityConfig
 from ..data.frames import Frame
 from ..data.mesh import TriMesh
-from ..geometry import triangle_cross
+from ..geometry import concat_meshes, triangle_cross
 
 UP = np.array([0.0, 0.0, 1.0])  # world = scan frame, z up (data/frames.py conventions)
 
@@ -71,13 +72,7 @@ def d_image(pf: PartFrame, frame: Frame | None, depth: np.ndarray | None, cfg: C
     """Farthest depth behind the front plane in a band around the part (segmenting frame)."""
     if frame is None or depth is None or frame.depth_intrinsics is None:
         return np.inf
-    K = frame.depth_intrinsics.K
-    h, w = depth.shape
-    u, v = np.meshgrid(np.arange(w, dtype=float), np.arange(h, dtype=float))
-    z = depth.astype(float)
-    ok = z > 0
-    pc = np.stack([(u - K[0, 2]) / K[0, 0] * z, (v - K[1, 2]) / K[1, 1] * z, z], -1)[ok]
-    pw = pc @ frame.c2w[:3, :3].T + frame.c2w[:3, 3]
+    pw = unproject(depth, frame.depth_intrinsics.K, frame.c2w)[depth > 0]
     rel = pw - pf.back
     a, b, c = rel @ pf.u, rel @ pf.v, rel @ pf.n
     inner = (np.abs(a) <= 0.5 * pf.su) & (np.abs(b) <= 0.5 * pf.sv)
@@ -156,13 +151,8 @@ def _box(lo: np.ndarray, hi: np.ndarray, pf: PartFrame, origin: np.ndarray) -> t
 
 
 def _merge(boxes: list[tuple[np.ndarray, np.ndarray]], color: int) -> TriMesh:
-    vs, fs, n = [], [], 0
-    for v, f in boxes:
-        vs.append(v)
-        fs.append(f + n)
-        n += len(v)
-    v = np.concatenate(vs)
-    return TriMesh(v, np.concatenate(fs), np.full((len(v), 3), color, np.uint8))
+    v, f = concat_meshes(boxes)
+    return TriMesh(v, f, np.full((len(v), 3), color, np.uint8))
 
 
 def wall_thickness(pf: PartFrame, cfg: CavityConfig) -> float:

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..data.mesh import TriMesh
+from ..geometry import concat_meshes
 from .materials import MATTE
 
 # The six faces of a unit cube as (normal axis, sign); grids are emitted per face so each face has
@@ -34,7 +35,7 @@ def box_mesh(lo: np.ndarray, hi: np.ndarray, edge: float, skip: tuple[tuple[int,
     """Axis-aligned box [lo, hi] with outward faces subdivided to ~``edge``; ``skip`` omits faces (axis, sign)."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     size = hi - lo
-    verts, faces, n = [], [], 0
+    pieces = []
     for axis, sign in _FACES:
         if (axis, sign) in skip:
             continue
@@ -49,10 +50,8 @@ def box_mesh(lo: np.ndarray, hi: np.ndarray, edge: float, skip: tuple[tuple[int,
         # (a1, a2, axis) is right-handed, so CCW in (u, v) faces +axis; flip for the -axis face.
         if sign < 0:
             tris = tris[:, ::-1]
-        verts.append(p)
-        faces.append(tris + n)
-        n += len(p)
-    return np.concatenate(verts), np.concatenate(faces)
+        pieces.append((p, tris))
+    return concat_meshes(pieces)
 
 
 @dataclass

@@ -130,3 +130,12 @@ def test_iou_matrix_agrees_with_pairwise_vertex_iou():
     sets = [rng.integers(0, 60, rng.integers(0, 30)) for _ in range(12)]
     m = geometry.iou_matrix(sets[:5], sets[5:])
     assert np.array_equal(m, [[geometry.vertex_iou(a, b) for b in sets[5:]] for a in sets[:5]])
+
+
+def test_concat_meshes_offsets_faces_and_horizontal_right():
+    sq, tet = unit_square(), tetrahedron()
+    v, f = geometry.concat_meshes([(sq.vertices, sq.faces), (tet.vertices, tet.faces)])
+    assert v.shape == (8, 3) and f.tolist() == sq.faces.tolist() + (tet.faces + 4).tolist()
+    # facing a wall whose normal points back at the viewer along -y, the right is +x
+    assert np.allclose(geometry.horizontal_right(np.array([0.0, -1.0, 0.0])), [1, 0, 0])
+    assert np.allclose(geometry.horizontal_right(np.array([2.0, 0.0, 0.0])), [0, 1, 0])

@@ -19,6 +19,7 @@ import numpy as np
 from ...config.perception import FrontRulesConfig
 from ...data.mesh import TriMesh
 from ...data.parts import Articulation
+from ...geometry import horizontal_right
 from .facets import Facets
 
 
@@ -54,8 +55,7 @@ class Front:
 def _frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     nh = np.array([n[0], n[1], 0.0])
     nh /= max(np.linalg.norm(nh), 1e-12)
-    u = np.cross([0.0, 0.0, 1.0], nh)  # right-hand side when looking at the front from the room
-    return nh, u / np.linalg.norm(u)
+    return nh, horizontal_right(nh)  # right-hand side when looking at the front from the room
 
 
 def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: np.ndarray,

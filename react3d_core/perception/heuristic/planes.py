@@ -14,6 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from ...data.mesh import TriMesh
+from ...geometry import horizontal_right
 
 
 @dataclass
@@ -118,20 +119,15 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
     return out
 
 
-def _basis(n: np.ndarray) -> np.ndarray:
-    u = np.cross([0.0, 0.0, 1.0], n)  # right-hand side when looking at the plane from its front
-    return u / np.linalg.norm(u)
-
-
 def _flip(p: Plane) -> Plane:
-    u = _basis(-p.n)
+    u = horizontal_right(-p.n)
     return Plane(-p.n, u, -p.d, p.faces, (-p.extent_u[1], -p.extent_u[0]), p.extent_v, p.area)
 
 
 def _pieces(sel: np.ndarray, cen: np.ndarray, area: np.ndarray, n: np.ndarray, d: float, cell: float,
             min_area: float) -> list[Plane]:
     """Split the faces ``sel`` of one plane into pieces connected on a ``cell`` grid."""
-    u = _basis(n)
+    u = horizontal_right(n)  # right-hand side when looking at the plane from its front
     pu, pv = cen[sel] @ u, cen[sel, 2]
     iu = np.floor((pu - pu.min()) / cell).astype(int)
     iv = np.floor((pv - pv.min()) / cell).astype(int)
