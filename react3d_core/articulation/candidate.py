@@ -18,7 +18,8 @@ from ..data.parts import OBB, Articulation, PartCandidate
 from .obb import min_obb
 from .refine import is_flat, refine_prismatic, refine_revolute, refine_sliding, slab_mid_and_thickness
 from .types import ArticulatedPart
-from .validate import best_prediction, lift_prediction
+from .upright import upright_box
+from .validate import best_prediction, consensus_joint, lift_prediction, matching_predictions
 
 
 @dataclass
@@ -32,10 +33,12 @@ class PartFit:
     flat: bool
 
 
-def fit_part(points: np.ndarray, camera: np.ndarray, plane_normal: np.ndarray | None, flat_ratio: float) -> PartFit:
-    """Min-area OBB; n_front = u1 x u2 oriented into the cavity: along the clipping plane's normal when the
-    segmentation gave one, else away from the camera that segmented the part."""
-    obb = min_obb(points)
+def fit_part(points: np.ndarray, camera: np.ndarray, plane_normal: np.ndarray | None, flat_ratio: float,
+             upright_tolerance: float = 0.0) -> PartFit:
+    """Min-area OBB (upright for a vertical front unless the minimal box is more than ``upright_tolerance``
+    smaller, :func:`.upright.upright_box`); n_front = u1 x u2 oriented into the cavity: along the clipping
+    plane's normal when the segmentation gave one, else away from the camera that segmented the part."""
+    obb = upright_box(points, min_obb(points), upright_tolerance)
     n = obb.R[:, 2].copy()
     if plane_normal is not None:
         n *= 1.0 if np.dot(n, plane_normal) >= 0 else -1.0
@@ -81,13 +84,22 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
     pred, iou, view = best_prediction(candidate, predictions)
     if pred is None or iou < config.articulation.valid_iou:
         return None
-    frame = next(f for f in scene.frames if f.frame_id == view)
-    depth = _frame_depth_rgb(scene, view, rasterizer) if pred.origin_cam is None else None
-    initial = lift_prediction(pred, frame, depth)
+    frames = {f.frame_id: f for f in scene.frames}
+    frame = frames[view]
+
+    def lifted(p: ArticulationPrediction, fid: str) -> Articulation:
+        depth = _frame_depth_rgb(scene, fid, rasterizer) if p.origin_cam is None else None
+        return lift_prediction(p, frames[fid], depth)
+
+    initial = lifted(pred, view)
+    if config.articulation.consensus_views:
+        others = [lifted(p, fid) for p, fid in matching_predictions(candidate, predictions, config.articulation.valid_iou)
+                  if p is not pred]
+        initial = consensus_joint(initial, others)
     pts = mesh.vertices[np.asarray(candidate.vertex_ids, np.int64)]
     seg_id = candidate.seg_frame_id or view
     cam = next((f.c2w[:3, 3] for f in scene.frames if f.frame_id == seg_id), frame.c2w[:3, 3])
-    fit = fit_part(pts, cam, candidate.plane_normal, config.articulation.flat_ratio)
+    fit = fit_part(pts, cam, candidate.plane_normal, config.articulation.flat_ratio, config.articulation.upright_tolerance)
     obb, n, thickness, flat = fit.obb, fit.front_normal, fit.thickness, fit.flat
     sliding = bool(pred.sliding and pred.joint_type == "prismatic")
     art = refine_articulation(initial, fit, config.articulation.refine, sliding)

@@ -8,4 +8,4 @@ from .scene import assemble_scene, attached_faces, carve_background, sliding_lim
 STAGE_VERSION = "3"  # 3: sliding doors: travel along their width, no drawer box
 STAGE = StageSpec("assembly", __name__, STAGE_VERSION, sections=("assembly", "limits"), upstream=("dedup", "cavity"))
 
-__all__ = ["STAGE", 'STAGE_VERSION', 'assemble_scene', 'attached_faces', 'carve_background', 'sliding_limits']
+__all__ = ["STAGE", "STAGE_VERSION", "assemble_scene", "attached_faces", "carve_background", "sliding_limits"]

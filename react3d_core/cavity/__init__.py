@@ -8,4 +8,4 @@ from .estimate import PartFrame, UP, base_mesh, d_body, d_hit, d_image, d_mesh, 
 STAGE_VERSION = "4"  # 3: d_body bounds the cavity by the furniture's own depth; 4: down-rays where nothing is above
 STAGE = StageSpec("cavity", __name__, STAGE_VERSION, sections=("cavity",), upstream=("articulation",))
 
-__all__ = ["STAGE", 'PartFrame', 'STAGE_VERSION', 'UP', 'base_mesh', 'd_body', 'd_hit', 'd_image', 'd_mesh', 'estimate_cavity', 'inner_box_mesh', 'wall_thickness']
+__all__ = ["STAGE", "PartFrame", "STAGE_VERSION", "UP", "base_mesh", "d_body", "d_hit", "d_image", "d_mesh", "estimate_cavity", "inner_box_mesh", "wall_thickness"]

@@ -11,6 +11,12 @@ class ArticulationConfig(StageConfig):
     valid_iou: float = Field(0.6, ge=0, le=1, description="Candidate valid if predictor mask IoU >= this in a top-k view.")
     refine: bool = Field(True, description="Snap axes/origins to the part's OBB (off for the ablation).")
     flat_ratio: float = Field(0.5, gt=0, le=1, description="Refine only flat parts: shortest OBB side < ratio x second.")
+    consensus_views: bool = Field(True, description="Initial joint from every top view whose prediction matches the part "
+                                                    "(median origin, mean axis) instead of the single best view (the paper): "
+                                                    "one view's origin error no longer hinges a door on the wrong edge.")
+    upright_tolerance: float = Field(0.1, ge=0, description="A vertical front keeps a gravity-aligned box unless the "
+                                                            "minimal box is smaller by more than this share of its "
+                                                            "volume (0: always the minimal box, as the paper).")
 
 
 class LimitConfig(StageConfig):

@@ -8,4 +8,4 @@ from .remove import dedup_indices, remove_duplicates
 STAGE_VERSION = "3"  # 2: stage 3 removes fragments; 3: stage 4 removes slivers inside a larger part's box
 STAGE = StageSpec("dedup", __name__, STAGE_VERSION, sections=("dedup",), upstream=("articulation",))
 
-__all__ = ["STAGE", 'STAGE_VERSION', 'dedup_indices', 'remove_duplicates']
+__all__ = ["STAGE", "STAGE_VERSION", "dedup_indices", "remove_duplicates"]

@@ -114,3 +114,51 @@ def test_lift_prediction_to_world_hand_computed(tmp_path) -> None:  # noqa: ANN0
     np.testing.assert_allclose(a.axis, [0, 0, 1], atol=1e-12)  # camera up (-y) is world +z
     # pixel (3, 2) at 2 m: camera point (0.02, 0, 2) -> world (1 + 2, 2 - 0.02, 3)
     np.testing.assert_allclose(a.origin, [3.0, 1.98, 3.0], atol=1e-12)
+
+
+def test_consensus_joint_takes_the_median_origin_and_the_mean_axis_of_the_views() -> None:
+    from react3d_core.articulation.validate import consensus_joint
+
+    def rev(o, a) -> Articulation:  # noqa: ANN001
+        return Articulation(joint_type="revolute", axis=a, origin=o, lower=0.0, upper=0.0, limit_source="unset")
+
+    best = rev((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    others = [rev((1.0, 0.0, 0.0), (0.0, 0.0, -1.0)), rev((0.2, 0.4, 0.0), (0.0, 0.0, 1.0)),
+              rev((0.1, 0.0, 2.0), (0.0, 0.0, -1.0)),
+              Articulation(joint_type="prismatic", axis=(1.0, 0, 0), origin=(9.0, 9.0, 9.0), lower=0.0, upper=0.0,
+                           limit_source="unset")]  # another joint type does not vote
+    out = consensus_joint(best, others)
+    # x: median(0, 1, 0.2, 0.1) = 0.15; y: median(0, 0, 0.4, 0) = 0; z: median(0, 0, 0, 2) = 0
+    assert np.allclose(out.origin, (0.15, 0.0, 0.0))
+    assert np.allclose(out.axis, (0.0, 0.0, 1.0))  # flipped axes are aligned to the best view's before averaging
+    assert out.joint_type == "revolute" and consensus_joint(best, []) == best
+
+
+def test_vertical_fronts_keep_an_upright_box_unless_the_minimal_one_is_clearly_smaller() -> None:
+    from react3d_core.articulation.upright import upright_box
+
+    rng = np.random.default_rng(0)
+    # a 0.40 x 0.70 m door in the x-z plane (normal y), segmented 6 cm sheared (a parallelogram): its
+    # minimal box leans 4.9 degrees and is 7.8 % smaller than the upright one
+    u, z = rng.uniform(0, 0.4, 3000), rng.uniform(0, 0.7, 3000)
+    door = np.c_[u, rng.uniform(0, 0.02, 3000), z]
+    pts = np.c_[u + 0.06 * z / 0.7, door[:, 1], z]
+    m = min_obb(pts)
+    tilt = np.degrees(np.arccos(min(1.0, abs(m.R[:, 0] @ [0, 0, 1.0]))))
+    assert 4.0 < tilt < 6.0
+    up = upright_box(pts, m, 0.1)
+    assert np.allclose(np.abs(up.R[:, 0]), [0, 0, 1]) and np.allclose(np.abs(up.R[:, 2]), [0, 1, 0])
+    assert np.allclose(up.extents, (0.7, 0.46, 0.02), atol=6e-3)  # random samples reach 0.455 of 0.46
+    assert upright_box(pts, m, 0.05) == m  # the upright box is 7.8 % larger: beyond a 5 % tolerance
+    assert upright_box(pts, m, 0.0) == m  # tolerance 0: the paper's minimal box
+
+    # a front that really leans (30 degrees in its plane): the upright box is far larger, the minimal box stays
+    t = np.radians(30)
+    rot = np.array([[np.cos(t), 0, -np.sin(t)], [0, 1, 0], [np.sin(t), 0, np.cos(t)]])
+    leaning = door @ rot.T
+    m2 = min_obb(leaning)
+    assert upright_box(leaning, m2, 0.1) == m2
+    # a horizontal part (a drawer bottom, normal z) is not a vertical front
+    flat = door[:, [0, 2, 1]]
+    m3 = min_obb(flat)
+    assert upright_box(flat, m3, 0.1) == m3
