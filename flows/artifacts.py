@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import re
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -17,12 +18,19 @@ def _key(s: str) -> str:
 
 class Progress:
     """A ``progress(stage, done, total)`` callback (``react3d_core.pipeline.ProgressFn``) that forwards to
-    an optional hook (the CLI's bar) and updates a Prefect progress artifact for the UI."""
+    an optional hook (the CLI's bar) and updates a Prefect progress artifact for the UI.
+
+    The artifact is updated when a stage completes and otherwise at most every ``min_interval_s``: each
+    update is an API request, and one per part and frame batch cost a cached conversion 1.3 s."""
 
     STAGES = ("perception", "segmentation", "articulation", "assembly", "export", "report")
 
-    def __init__(self, hook: Callable[[str, int, int], None] | None) -> None:
+    def __init__(self, hook: Callable[[str, int, int], None] | None, min_interval_s: float = 2.0,
+                 clock: Callable[[], float] = time.monotonic) -> None:
         self.hook = hook
+        self.min_interval_s, self.clock = min_interval_s, clock
+        self._last = -float("inf")
+        self.updates = 0
         self._artifact = None
         try:
             from prefect.artifacts import create_progress_artifact
@@ -35,14 +43,22 @@ class Progress:
         if self.hook:
             self.hook(stage, done, total)
         if self._artifact is not None and done:
-            from prefect.artifacts import update_progress_artifact
+            now = self.clock()
+            if done < total and now - self._last < self.min_interval_s:
+                return
+            self._last = now
+            self._update(stage, done, total)
 
-            idx = self.STAGES.index(stage) if stage in self.STAGES else 0
-            frac = (idx + done / max(total, 1)) / len(self.STAGES)
-            try:
-                update_progress_artifact(self._artifact, min(100.0, 100.0 * frac))
-            except Exception:  # noqa: BLE001 - progress is cosmetic; never fail a conversion over it
-                pass
+    def _update(self, stage: str, done: int, total: int) -> None:
+        from prefect.artifacts import update_progress_artifact
+
+        self.updates += 1
+        idx = self.STAGES.index(stage) if stage in self.STAGES else 0
+        frac = (idx + done / max(total, 1)) / len(self.STAGES)
+        try:
+            update_progress_artifact(self._artifact, min(100.0, 100.0 * frac))
+        except Exception:  # noqa: BLE001 - progress is cosmetic; never fail a conversion over it
+            pass
 
 
 def scene_summary_markdown(scene_id: str, manifest_path: str, html: str | None, timings: dict[str, float],

@@ -9,16 +9,18 @@ from __future__ import annotations
 import json
 import time
 from functools import lru_cache
+from pathlib import Path
 from typing import Any
 
 from prefect import task
 
+from react3d_core.atomic import atomic_path
 from react3d_core.config import FrameSelectionConfig
 from react3d_core.data.mesh import load_mesh
 from react3d_core.pipeline import LoadedScene, load
 from react3d_core.raster import Rasterizer
 
-from .store import tree_fingerprint
+from .store import cache_root, tree_fingerprint
 
 
 @lru_cache(maxsize=2)
@@ -27,10 +29,32 @@ def rasterizer(mesh_path: str) -> Rasterizer:
     return Rasterizer(load_mesh(mesh_path))
 
 
+class CachedSelections:
+    """Keyframe selections remembered in the local cache (``$REACT3D_CACHE/selections/<key>.json``), keyed
+    by what they depend on (``react3d_core.scene_io.selection.selection_key``): a re-run of a capture
+    does not render its frames again to choose them (2-3 s of a cached RedKitchen convert)."""
+
+    def _path(self, key: str) -> Path:
+        return cache_root() / "selections" / key[:2] / f"{key}.json"
+
+    def get(self, key: str) -> dict[str, Any] | None:
+        try:
+            value = json.loads(self._path(key).read_text())
+        except (OSError, ValueError):
+            return None  # missing or unreadable: select again (and rewrite it)
+        return value if isinstance(value, dict) else None
+
+    def put(self, key: str, value: dict[str, Any]) -> None:
+        path = self._path(key)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with atomic_path(path) as tmp:
+            tmp.write_text(json.dumps(value))
+
+
 @lru_cache(maxsize=4)
 def _loaded(scene_path: str, frames_json: str) -> LoadedScene:
     return load(scene_path, FrameSelectionConfig.model_validate(json.loads(frames_json)),
-                raster_for=lambda mesh_path: rasterizer(str(mesh_path)))
+                raster_for=lambda mesh_path: rasterizer(str(mesh_path)), memo=CachedSelections())
 
 
 def loaded_scene(scene_path: str, config: dict[str, Any]) -> LoadedScene:

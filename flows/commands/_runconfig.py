@@ -80,7 +80,7 @@ def precheck_scene(scene: str, cfg: dict[str, Any]) -> str:
 
 def _check_formats(formats: object) -> None:
     """Unknown export formats used to fail only at the export stage, minutes in, with a traceback."""
-    from react3d_core.export.scene import FORMATS
+    from react3d_core.config.export import FORMATS
 
     bad = [f for f in formats if f not in FORMATS] if isinstance(formats, (list, tuple)) else [formats]
     if bad:

@@ -6,11 +6,15 @@ from pydantic import Field
 
 from ._base import StageConfig
 
+FORMATS = ("urdf", "usd", "mjcf")
+"""Simulator formats the exporters write (here, not in react3d_core.export: checking a command line's
+formats must not import the exporters, 1.8 s of a cached convert's start-up)."""
+
 
 class ExportConfig(StageConfig):
     """What the exporters write."""
 
-    formats: tuple[str, ...] = Field(("urdf", "usd", "mjcf"), description="Formats written by convert/export.")
+    formats: tuple[str, ...] = Field(FORMATS, description="Formats written by convert/export.")
     texel_per_m: float = Field(400.0, gt=0, description="Texture budget: texels per metre of surface (side length).")
     min_texture: int = Field(64, ge=8, description="Smallest texture side (px).")
     max_texture: int = Field(4096, ge=64, description="Largest texture side (px).")

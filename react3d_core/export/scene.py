@@ -15,13 +15,12 @@ import os
 from pathlib import Path
 
 from ..atomic import atomic_dir
-from ..config.export import ExportConfig
+from ..config.export import FORMATS, ExportConfig
 from ..data.parts import InteractiveScene
 from ..errors import InputError
 from .assets import ASSETS, LinkFiles, write_link_assets
 from .model import SceneModel, build_scene_model
 
-FORMATS = ("urdf", "usd", "mjcf")
 FILES = {"urdf": "urdf/scene.urdf", "usd": "usd/scene.usda", "mjcf": "mjcf/scene.xml"}
 
 

@@ -19,6 +19,7 @@ from ..data.mesh import TriMesh, load_mesh
 from ..data.parts import InteractiveScene, PartCandidate
 from ..perception.interfaces import Perception, PointPromptSegmenter
 from ..raster import Rasterizer
+from ..scene_io.selection import SelectionMemo
 from .stages import view
 
 T = TypeVar("T")
@@ -34,11 +35,11 @@ class LoadedScene:
 
 
 def load(scene_path: str | Path, frames: FrameSelectionConfig,
-         raster_for: Callable[[str | Path], Rasterizer] | None = None) -> LoadedScene:
+         raster_for: Callable[[str | Path], Rasterizer] | None = None, memo: SelectionMemo | None = None) -> LoadedScene:
     """Load and validate the scan (units included) and select its frames (keyframes by default).
 
     ``raster_for(mesh_path)``: where the scan's rasterizer comes from (a worker keeps one per mesh);
-    by default it is built here, once."""
+    by default it is built here, once. ``memo``: remembered keyframe selections (``SelectionMemo``)."""
     from ..scene_io import load_scene
     from ..scene_io.scale import check_scale
 
@@ -50,7 +51,7 @@ def load(scene_path: str | Path, frames: FrameSelectionConfig,
                 built[str(mesh_path)] = Rasterizer(load_mesh(mesh_path))
             return built[str(mesh_path)]
 
-    scene = load_scene(scene_path, frames, rasterizer=raster_for)
+    scene = load_scene(scene_path, frames, rasterizer=raster_for, memo=memo)
     raster = raster_for(scene.mesh_path)
     check_scale(scene, raster.mesh)  # a millimetre mesh otherwise gives 0 parts, rc 0
     return LoadedScene(scene, raster.mesh, raster)

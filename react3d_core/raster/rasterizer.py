@@ -11,8 +11,10 @@ answers closest-point and distance queries on the same BVH.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -53,16 +55,30 @@ class RasterResult:
 
 
 class Rasterizer:
-    """Holds the mesh in an Embree BVH once; renders any number of views."""
+    """Holds the mesh in an Embree BVH once; renders any number of views.
+
+    The BVH (and Open3D) is built on the first ray cast, not here: a conversion whose every step is
+    cached never casts one, and building it was most of such a run's start-up. Thread-safe."""
 
     def __init__(self, mesh: TriMesh, n_threads: int = 0) -> None:
-        import open3d as o3d
-
         self.mesh = mesh
-        self._scene = o3d.t.geometry.RaycastingScene(nthreads=n_threads)
-        vt = o3d.core.Tensor(np.ascontiguousarray(mesh.vertices, dtype=np.float32))
-        ft = o3d.core.Tensor(np.ascontiguousarray(mesh.faces, dtype=np.uint32))
-        self._scene.add_triangles(vt, ft)
+        self._n_threads = n_threads
+        self._built: Any = None
+        self._lock = threading.Lock()
+
+    @property
+    def _scene(self) -> Any:
+        if self._built is None:
+            with self._lock:
+                if self._built is None:
+                    import open3d as o3d
+
+                    scene = o3d.t.geometry.RaycastingScene(nthreads=self._n_threads)
+                    vt = o3d.core.Tensor(np.ascontiguousarray(self.mesh.vertices, dtype=np.float32))
+                    ft = o3d.core.Tensor(np.ascontiguousarray(self.mesh.faces, dtype=np.uint32))
+                    scene.add_triangles(vt, ft)
+                    self._built = scene
+        return self._built
 
     def cast_rays(self, origins: np.ndarray, directions: np.ndarray) -> RayHits:
         """First hit along each ray (origins and directions (..., 3), cast to float32; directions need

@@ -23,7 +23,7 @@ from ..errors import InputError
 from ..raster import Rasterizer
 from .depth_bin import DepthBin
 from .images import check_jpeg_complete, depth_size_problem
-from .selection import FrameSelection, choose_frames
+from .selection import FrameSelection, SelectionMemo, choose_frames_memo
 
 DEPTH_SIZE = (256, 192)
 
@@ -274,12 +274,14 @@ def _load_generic(root: Path, scannetpp_world: bool | None = None) -> SceneInput
 
 def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, *,
                layout: str | None = None, scannetpp_world: bool | None = None,
-               cache_dir: str | Path | None = None, rasterizer: Callable[[Path], Rasterizer] | None = None) -> SceneInput:
+               cache_dir: str | Path | None = None, rasterizer: Callable[[Path], Rasterizer] | None = None,
+               memo: SelectionMemo | None = None) -> SceneInput:
     """Load any supported layout (auto-detected unless ``layout`` is given), then select frames.
 
     ``cache_dir`` (DSLR only; default ``<scene>/.react3d_cache``) receives undistorted images and rendered depth.
     ``rasterizer(mesh_path)`` gives the scan's :class:`~react3d_core.raster.Rasterizer` for the coverage rule
-    of keyframe selection (default: built from the mesh here; callers that keep one pass theirs)."""
+    of keyframe selection (default: built from the mesh here; callers that keep one pass theirs);
+    ``memo`` remembers keyframe selections by content, so a re-run does not render the frames again."""
     root = Path(path)
     if not root.is_dir():
         raise InputError(root, "scene folder not found")
@@ -289,10 +291,10 @@ def load_scene(path: str | Path, selection: FrameSelectionConfig | None = None, 
     def sel(frames: list[Frame], mesh: Path) -> list[Frame]:
         if selection is None:
             return frames
-        r = None
-        if selection.stride is None and selection.coverage_width > 0:
-            r = rasterizer(mesh) if rasterizer is not None else _default_rasterizer(mesh)
-        chosen.append(choose_frames(frames, selection, r))
+        def raster() -> Rasterizer:
+            return rasterizer(mesh) if rasterizer is not None else _default_rasterizer(mesh)
+
+        chosen.append(choose_frames_memo(frames, selection, mesh, raster, memo))
         return chosen[-1].frames
 
     if layout == "scannetpp_dslr":

@@ -11,8 +11,11 @@ sparse capture of the same walk give similar selections. Then an even cap.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import hashlib
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -22,6 +25,16 @@ from ..data.frames import Frame
 from ..raster import Rasterizer
 
 _HASH_BITS = 22  # 4 M counters (16 MB); collisions only merge far-apart voxels' counts
+SELECTION_VERSION = "1"  # bump when the selection rules change: memoised selections are then recomputed
+
+
+class SelectionMemo(Protocol):
+    """Where keyframe selections are remembered between runs (``tasks.scene`` keeps them in the cache):
+    the coverage rule renders every candidate frame, which a re-run of the same capture need not redo."""
+
+    def get(self, key: str) -> dict[str, Any] | None: ...
+
+    def put(self, key: str, value: dict[str, Any]) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -119,6 +132,43 @@ def choose_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer
     reason = (f"kept {len(capped)} of {len(frames)} frames: stride {cfg.stride}{filt}"
               + (f", cap {cfg.max_frames}" if cfg.max_frames is not None else ""))
     return FrameSelection(capped, len(frames), reason, dropped_by_cap=len(out) - len(capped))
+
+
+def selection_key(frames: Sequence[Frame], cfg: FrameSelectionConfig, mesh_path: str | Path) -> str:
+    """What a selection depends on: the rules and settings, every frame's id, pose and intrinsics, and the
+    mesh's bytes (coverage is measured on it)."""
+    h = hashlib.sha256(f"{SELECTION_VERSION}|{cfg.model_dump_json()}".encode())
+    for f in frames:
+        h.update(f.frame_id.encode())
+        h.update(np.ascontiguousarray(f.c2w, np.float64).tobytes())
+        h.update(f.intrinsics.model_dump_json().encode())
+    with open(mesh_path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
+
+
+def choose_frames_memo(frames: Sequence[Frame], cfg: FrameSelectionConfig, mesh_path: str | Path,
+                       raster: Callable[[], Rasterizer], memo: SelectionMemo | None) -> FrameSelection:
+    """:func:`choose_frames`, remembered in ``memo`` when the coverage rule runs (the costly one: it
+    renders every candidate frame). ``raster()`` gives the scan's Rasterizer, called only when needed."""
+    frames = list(frames)
+    coverage = cfg.stride is None and cfg.coverage_width > 0
+    if not coverage:
+        return choose_frames(frames, cfg)
+    if memo is None:
+        return choose_frames(frames, cfg, raster())
+    key = selection_key(frames, cfg, mesh_path)
+    hit = memo.get(key)
+    by_id = {f.frame_id: f for f in frames}
+    if hit is not None and hit.get("frame_ids") and all(i in by_id for i in hit["frame_ids"]):
+        return FrameSelection([by_id[i] for i in hit["frame_ids"]], len(frames), hit["reason"],
+                              hit.get("skipped_motion", 0), hit.get("skipped_coverage", 0), hit.get("dropped_by_cap", 0))
+    out = choose_frames(frames, cfg, raster())
+    memo.put(key, {"frame_ids": [f.frame_id for f in out.frames], "reason": out.reason,
+                   "skipped_motion": out.skipped_motion, "skipped_coverage": out.skipped_coverage,
+                   "dropped_by_cap": out.dropped_by_cap})
+    return out
 
 
 def select_frames(frames: Sequence[Frame], cfg: FrameSelectionConfig, rasterizer: Rasterizer | None = None) -> list[Frame]:

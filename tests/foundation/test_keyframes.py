@@ -115,3 +115,44 @@ def test_load_scene_reports_the_selection(tmp_path: Path) -> None:
     assert "/coverage" in s.frame_selection and s.frame_selection.endswith("skipped 1 no new surface")
     assert load_scene(root, FrameSelectionConfig(stride=2)).frame_selection == "kept 3 of 6 frames: stride 2"
     assert load_scene(root).frame_selection == ""  # no selection asked for
+
+
+def test_a_remembered_selection_is_reused_and_follows_poses_and_mesh(tmp_path: Path) -> None:
+    from react3d_core.data.mesh import save_mesh
+    from react3d_core.scene_io.selection import choose_frames_memo, selection_key
+
+    class Memo(dict):
+        def get(self, key):  # noqa: ANN001, ANN201
+            return super().get(key)
+
+        def put(self, key, value) -> None:  # noqa: ANN001
+            self[key] = value
+
+    wall = _wall()
+    mesh = tmp_path / "wall.ply"
+    save_mesh(mesh, wall.mesh)
+    frames = _frames(_walk(np.r_[np.linspace(0, 3, 31), np.linspace(3, 0, 31)]))  # the wall walked twice
+    cfg = FrameSelectionConfig()
+    memo, built = Memo(), []
+
+    def raster() -> Rasterizer:
+        built.append(1)
+        return wall
+
+    first = choose_frames_memo(frames, cfg, mesh, raster, memo)
+    assert built == [1] and len(memo) == 1
+    assert [f.frame_id for f in first.frames] == [f.frame_id for f in choose_frames(frames, cfg, wall).frames]
+
+    def no_raster() -> Rasterizer:
+        raise AssertionError("a remembered selection renders nothing")
+
+    again = choose_frames_memo(frames, cfg, mesh, no_raster, memo)
+    assert [f.frame_id for f in again.frames] == [f.frame_id for f in first.frames] and again.reason == first.reason
+
+    key = selection_key(frames, cfg, mesh)
+    moved = _frames(_walk(np.r_[np.linspace(0, 3, 31), np.linspace(3, 0.1, 31)]))
+    assert selection_key(moved, cfg, mesh) != key  # another pose
+    assert selection_key(frames, cfg.model_copy(update={"coverage_min_new": 0.2}), mesh) != key  # another setting
+    mesh.write_bytes(mesh.read_bytes() + b"\n")
+    assert selection_key(frames, cfg, mesh) != key  # another mesh file
+    assert choose_frames_memo(frames, cfg.model_copy(update={"stride": 2}), mesh, no_raster, memo).total == 62

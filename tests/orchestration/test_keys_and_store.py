@@ -100,3 +100,16 @@ def test_openable_phrases_follow_the_paper() -> None:
 
     assert openable_phrases(["cabinet", "refrigerator"], PerceptionConfig()) == ["cabinet door", "door", "refrigerator door"]
     assert openable_phrases([], PerceptionConfig()) == ["door"]  # 'door' is always kept
+
+
+def test_cached_selections_round_trip_and_ignore_a_damaged_file(tmp_path, monkeypatch) -> None:  # noqa: ANN001
+    from tasks.scene import CachedSelections
+
+    monkeypatch.setenv("REACT3D_CACHE", str(tmp_path))
+    memo = CachedSelections()
+    assert memo.get("ab" * 32) is None
+    memo.put("ab" * 32, {"frame_ids": ["f1", "f3"], "reason": "kept 2 of 3 frames"})
+    assert memo.get("ab" * 32) == {"frame_ids": ["f1", "f3"], "reason": "kept 2 of 3 frames"}
+    path = tmp_path / "selections" / "ab" / f"{'ab' * 32}.json"
+    path.write_text("{not json")
+    assert memo.get("ab" * 32) is None  # selected again, never a traceback
