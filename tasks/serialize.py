@@ -107,7 +107,28 @@ def dumps(obj: Any) -> bytes:
 
 def loads(data: bytes) -> Any:
     """Decode bytes written by :func:`dumps` (pickles refused)."""
+    return loads_sized(data)[0]
+
+
+def loads_sized(data: bytes) -> tuple[Any, int]:
+    """:func:`loads`, and roughly how many bytes the decoded arrays take (packed masks count unpacked):
+    what keeping the object in memory costs."""
     with np.load(io.BytesIO(data), allow_pickle=False) as z:
         arrays = {k: z[k] for k in z.files}
-    tree = json.loads(arrays.pop("__tree__").tobytes().decode())
-    return _dec(tree, arrays)
+    tree_bytes = arrays.pop("__tree__").tobytes()
+    tree = json.loads(tree_bytes.decode())
+    packed = set(_bit_keys(tree))
+    size = len(tree_bytes) + sum(a.nbytes * (8 if k in packed else 1) for k, a in arrays.items())
+    return _dec(tree, arrays), size
+
+
+def _bit_keys(x: Any) -> Any:
+    """Keys of the bit-packed arrays in an encoded tree."""
+    if isinstance(x, list):
+        for v in x:
+            yield from _bit_keys(v)
+    elif isinstance(x, dict):
+        if "__bits__" in x:
+            yield x["__bits__"]
+        for v in x.values():
+            yield from _bit_keys(v)

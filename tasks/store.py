@@ -21,7 +21,8 @@ import re
 import shutil
 import socket
 import time
-from functools import lru_cache
+import threading
+from collections import OrderedDict
 from pathlib import Path
 from typing import Any
 
@@ -29,7 +30,7 @@ from react3d_core.atomic import atomic_path, pid_alive
 from react3d_core.errors import InputError
 
 from . import storage
-from .serialize import dumps, loads
+from .serialize import dumps, loads, loads_sized
 
 
 def cache_root() -> Path:
@@ -84,9 +85,40 @@ def get(handle: dict[str, str], cache: bool = True) -> Any:
     return _get_cached(handle["sha256"], str(path))
 
 
-@lru_cache(maxsize=24)
+DECODED_CACHE_BYTES = int(float(os.environ.get("REACT3D_DECODED_CACHE_MB", "512")) * 2**20)
+"""Budget of the per-process cache of decoded objects. It was 24 objects whatever their size: 24
+perception batches of a 300-frame capture (full-resolution masks) held 2-3 GB during articulation."""
+_decoded: OrderedDict[str, tuple[Any, int]] = OrderedDict()
+_decoded_lock = threading.Lock()
+
+
 def _get_cached(sha: str, path: str) -> Any:
-    return loads(_read_verified(Path(path), sha))
+    """Decoded objects, most recently used last, within :data:`DECODED_CACHE_BYTES`."""
+    with _decoded_lock:
+        if sha in _decoded:
+            _decoded.move_to_end(sha)
+            return _decoded[sha][0]
+    obj, size = loads_sized(_read_verified(Path(path), sha))
+    if size <= DECODED_CACHE_BYTES:
+        with _decoded_lock:
+            _decoded[sha] = (obj, size)
+            total = sum(n for _, n in _decoded.values())
+            while total > DECODED_CACHE_BYTES and len(_decoded) > 1:
+                _, (_, n) = _decoded.popitem(last=False)
+                total -= n
+    return obj
+
+
+def clear_decoded() -> None:
+    """Forget every decoded object (a quarantined file must not be served from memory)."""
+    with _decoded_lock:
+        _decoded.clear()
+
+
+def decoded_cache_bytes() -> int:
+    """What the decoded-object cache holds now (bytes)."""
+    with _decoded_lock:
+        return sum(n for _, n in _decoded.values())
 
 
 def _pull_object(path: Path) -> bool:
@@ -171,7 +203,7 @@ def quarantine(path: Path, why: str) -> Path | None:
     qdir.mkdir(parents=True, exist_ok=True)
     dest = qdir / f"{path.name}.{time.strftime('%Y%m%dT%H%M%S')}-{os.getpid()}"
     _verified.pop(str(path), None)
-    _get_cached.cache_clear()
+    clear_decoded()
     try:
         os.replace(path, dest)
     except FileNotFoundError:

@@ -35,7 +35,7 @@ def _as_worker(monkeypatch: pytest.MonkeyPatch, mirror: Path) -> None:
     monkeypatch.setenv("REACT3D_CACHE", str(mirror))
     from tasks import store
 
-    store._get_cached.cache_clear()
+    store.clear_decoded()
     store._verified.clear()
 
 

@@ -113,3 +113,19 @@ def test_cached_selections_round_trip_and_ignore_a_damaged_file(tmp_path, monkey
     path = tmp_path / "selections" / "ab" / f"{'ab' * 32}.json"
     path.write_text("{not json")
     assert memo.get("ab" * 32) is None  # selected again, never a traceback
+
+
+def test_decoded_objects_are_kept_within_a_byte_budget(tmp_path, monkeypatch) -> None:  # noqa: ANN001
+    monkeypatch.setenv("REACT3D_CACHE", str(tmp_path))
+    store.clear_decoded()
+    mask = np.zeros((1000, 1000), bool)
+    obj, size = serialize.loads_sized(serialize.dumps({"m": mask}))
+    assert obj["m"].shape == (1000, 1000) and 1_000_000 <= size < 1_001_000  # packed on disk, 1 byte a pixel decoded
+    monkeypatch.setattr(store, "DECODED_CACHE_BYTES", 2_500_000)
+    handles = [store.put({"m": mask, "i": i}, "x") for i in range(5)]
+    for h in handles:
+        store.get(h)
+    assert store.decoded_cache_bytes() <= 2_500_000
+    assert store._decoded and list(store._decoded) == [h["sha256"] for h in handles[-2:]]  # the most recent stay
+    assert store.get(handles[-1])["i"] == 4
+    store.clear_decoded()
