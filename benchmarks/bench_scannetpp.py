@@ -7,7 +7,7 @@ wall time and peak memory per stage.
 The scene is a procedural kitchen (``react3d_core.synthetic``) rendered with ``--frames`` RGB-D frames,
 its scan mesh subdivided to ``--faces`` (``benchmarks/scaling.py: densify``). Each run is a separate
 process (``--child``): its stages are timed by the flow (manifest ``timings``) and its resident memory
-is sampled every 0.1 s and attributed to the stage in progress (progress hook of the flow). Uses the
+is sampled every 0.1 s and attributed to the stage in progress (the flow's progress callback). Uses the
 Prefect server named by PREFECT_API_URL if set, else the temporary one. Prints a table and writes
 ``benchmarks/results/scannetpp_1m.json``.
 """
@@ -59,8 +59,7 @@ def child(scene: str, out: str, config: dict[str, Any], report: str) -> None:
 
     th = threading.Thread(target=sample, daemon=True)
     th.start()
-    cs.PROGRESS_HOOK = hook
-    manifest = cs.convert_scene(scene, out, config)
+    manifest = cs.convert_scene(scene, out, config, progress=hook)
     wall = time.perf_counter() - t0
     stop.set()
     th.join()
