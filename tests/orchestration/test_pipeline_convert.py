@@ -7,11 +7,13 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from flows.convert_scene import convert_scene
 from react3d_core.data.parts import InteractiveScene
 
 ROOT = Path(__file__).resolve().parents[2]
-CFG = {"frames": {"stride": 1}, "export": {"formats": ["urdf"]}}  # the default, weight-free heuristic
+CFG = {"frames": {"stride": 1}, "perception": {"backend": "oracle"}, "export": {"formats": ["urdf"]}}
 
 PIPELINE = """
 import json, sys
@@ -31,9 +33,20 @@ def _joints(manifest: Path) -> list[dict]:
 
 def test_pipeline_convert_equals_the_flow_without_importing_prefect(synthetic_scene, tmp_path: Path,  # noqa: ANN001
                                                                      monkeypatch) -> None:
-    scene = synthetic_scene(seed=3, n_frames=16, kind="dresser")
+    _same_as_the_flow(synthetic_scene(seed=3, n_frames=16, kind="dresser"), tmp_path, monkeypatch, CFG)
+
+
+@pytest.mark.slow
+def test_the_demo_scene_with_default_settings(tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
+    """The issue's words: the built-in demo scene, the default (weight-free heuristic) config."""
+    from react3d_core.synthetic import demo_scene
+
+    _same_as_the_flow(demo_scene(tmp_path / "demo"), tmp_path, monkeypatch, {"export": {"formats": ["urdf"]}})
+
+
+def _same_as_the_flow(scene: Path, tmp_path: Path, monkeypatch, cfg: dict) -> None:  # noqa: ANN001
     monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "cache"))  # the flow computes, it does not reuse
-    out = subprocess.run([sys.executable, "-c", PIPELINE, str(scene), str(tmp_path / "core"), json.dumps(CFG)],
+    out = subprocess.run([sys.executable, "-c", PIPELINE, str(scene), str(tmp_path / "core"), json.dumps(cfg)],
                          cwd=ROOT, capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr[-2000:]
     info = json.loads(out.stdout.strip().splitlines()[-1])
@@ -41,7 +54,7 @@ def test_pipeline_convert_equals_the_flow_without_importing_prefect(synthetic_sc
                     "stages": ["articulation", "assembly", "export", "perception", "report", "segmentation"]}
     assert info["n"] > 0
 
-    flow_manifest = Path(convert_scene(str(scene), str(tmp_path / "flow"), CFG))
+    flow_manifest = Path(convert_scene(str(scene), str(tmp_path / "flow"), cfg))
     core_manifest = tmp_path / "core" / "scene.json"
     assert _joints(core_manifest) == _joints(flow_manifest)
     a, b = InteractiveScene.load(core_manifest), InteractiveScene.load(flow_manifest)
