@@ -12,8 +12,10 @@ import time
 from typing import Any
 
 from tasks import prefect_env
+from tasks.memory import limit_malloc_arenas
 
 prefect_env.configure()
+limit_malloc_arenas()  # before the task runner's threads exist: two heaps, not one per thread (tasks/memory.py)
 
 from prefect import flow  # noqa: E402
 from prefect.task_runners import ThreadPoolTaskRunner  # noqa: E402
