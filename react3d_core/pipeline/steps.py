@@ -6,7 +6,6 @@
 
 from __future__ import annotations
 
-import shutil
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,11 +26,14 @@ T = TypeVar("T")
 
 @dataclass
 class LoadedScene:
-    """A scan with its selected frames, its mesh and one rasterizer shared by every stage."""
+    """A scan with its selected frames and one rasterizer (holding the mesh) shared by every stage."""
 
     scene: SceneInput
-    mesh: TriMesh
     raster: Rasterizer
+
+    @property
+    def mesh(self) -> TriMesh:
+        return self.raster.mesh
 
 
 def load(scene_path: str | Path, frames: FrameSelectionConfig,
@@ -54,7 +56,7 @@ def load(scene_path: str | Path, frames: FrameSelectionConfig,
     scene = load_scene(scene_path, frames, rasterizer=raster_for, memo=memo)
     raster = raster_for(scene.mesh_path)
     check_scale(scene, raster.mesh)  # a millimetre mesh otherwise gives 0 parts, rc 0
-    return LoadedScene(scene, raster.mesh, raster)
+    return LoadedScene(scene, raster)
 
 
 def openable_phrases(kept: Sequence[str], cfg: PerceptionConfig) -> list[str]:
@@ -179,17 +181,3 @@ def finalize(manifest_path: str | Path, config: dict[str, Any], versions: dict[s
     m.model_copy(update={"config": config, "versions": {**m.versions, **versions},
                          "timings": {**m.timings, **timings}}).save(manifest_path)
 
-
-def copy_folder(src: Path, dst: Path) -> None:
-    """Copy ``src`` into ``dst``, stopping at the first failure with one OSError naming the target file
-    (``shutil.copytree`` collects every failed file into one exception: 642 KB for a full disk)."""
-    for p in sorted(src.rglob("*")):
-        target = dst / p.relative_to(src)
-        try:
-            if p.is_dir():
-                target.mkdir(parents=True, exist_ok=True)
-            else:
-                target.parent.mkdir(parents=True, exist_ok=True)
-                shutil.copy2(p, target)
-        except OSError as exc:
-            raise OSError(exc.errno, exc.strerror, str(target)) from None
