@@ -22,7 +22,6 @@ from react3d_core.config import ExportConfig
 from react3d_core.pipeline import OUTPUT_KIND, key_material, output_marker, step_config
 from react3d_core.pipeline import assemble as assemble_step
 from react3d_core.pipeline import export as export_step
-from react3d_core.pipeline.steps import copy_folder
 
 from .keys import canonical, content_key
 from .scene import loaded_scene
@@ -89,11 +88,26 @@ def fill_output(result: dict[str, Any], staging: str | Path, out_dir: str | Path
     manifest = InteractiveScene.load(src / "scene.json")
     mesh = Path(scan_mesh_path) if scan_mesh_path else Path(manifest.input_mesh)
     mesh = mesh.resolve() if mesh.is_absolute() or scan_mesh_path else (src / mesh).resolve()
-    copy_folder(src, staging)
+    _copy_folder(src, staging)
     # the scan mesh stays where it is: re-point the manifest's reference from the new folder
     rel = os.path.relpath(mesh, out.resolve())
     manifest.model_copy(update={"input_mesh": rel}).save(staging / "scene.json")
     return str(staging / "scene.json")
+
+
+def _copy_folder(src: Path, dst: Path) -> None:
+    """Copy ``src`` into ``dst``, stopping at the first failure with one OSError naming the target file
+    (``shutil.copytree`` collects every failed file into one exception: 642 KB for a full disk)."""
+    for p in sorted(src.rglob("*")):
+        target = dst / p.relative_to(src)
+        try:
+            if p.is_dir():
+                target.mkdir(parents=True, exist_ok=True)
+            else:
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copy2(p, target)
+        except OSError as exc:
+            raise OSError(exc.errno, exc.strerror, str(target)) from None
 
 
 def publish_body(result: dict[str, Any], out_dir: str, scan_mesh_path: str | None = None,
