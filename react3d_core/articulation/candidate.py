@@ -19,7 +19,7 @@ from .obb import min_obb
 from .refine import is_flat, refine_prismatic, refine_revolute, refine_sliding, slab_mid_and_thickness
 from .types import ArticulatedPart
 from .upright import upright_box
-from .validate import best_prediction, consensus_joint, lift_prediction, matching_predictions
+from .validate import best_prediction, consensus_joint, lift_prediction, matching_predictions, view_matches
 
 
 @dataclass
@@ -81,7 +81,8 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
                          predictions: dict[str, list[ArticulationPrediction]], config: PipelineConfig,
                          rasterizer=None) -> ArticulatedPart | None:  # noqa: ANN001
     """None when no prediction matches the candidate (IoU < valid_iou in every top view)."""
-    pred, iou, view = best_prediction(candidate, predictions)
+    matches = view_matches(candidate, predictions)  # one pass of mask IoUs for validation and consensus
+    pred, iou, view = best_prediction(candidate, predictions, matches)
     if pred is None or iou < config.articulation.valid_iou:
         return None
     frames = {f.frame_id: f for f in scene.frames}
@@ -93,8 +94,8 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
 
     initial = lifted(pred, view)
     if config.articulation.consensus_views:
-        others = [lifted(p, fid) for p, fid in matching_predictions(candidate, predictions, config.articulation.valid_iou)
-                  if p is not pred]
+        others = [lifted(p, fid) for p, fid in matching_predictions(candidate, predictions, config.articulation.valid_iou,
+                                                                    matches) if p is not pred]
         initial = consensus_joint(initial, others)
     pts = mesh.vertices[np.asarray(candidate.vertex_ids, np.int64)]
     seg_id = candidate.seg_frame_id or view

@@ -24,34 +24,43 @@ def mask_iou(a: np.ndarray, b: np.ndarray) -> float:
     return float(inter / union) if union else 0.0
 
 
-def best_prediction(candidate: PartCandidate, predictions: dict[str, list[ArticulationPrediction]]
-                    ) -> tuple[ArticulationPrediction | None, float, str | None]:
-    """The prediction with the highest mask IoU over the candidate's top views (and that IoU)."""
-    best, best_iou, best_view = None, 0.0, None
-    for view in candidate.top_views:
-        if view.mask is None:
-            continue
-        for p in predictions.get(view.frame_id, []):
-            iou = mask_iou(view.mask.mask, p.mask)
-            if iou > best_iou:
-                best, best_iou, best_view = p, iou, view.frame_id
-    return best, best_iou, best_view
-
-
-def matching_predictions(candidate: PartCandidate, predictions: dict[str, list[ArticulationPrediction]],
-                         valid_iou: float) -> list[tuple[ArticulationPrediction, str]]:
-    """Every (prediction, view) whose mask matches the candidate's in one of its top views (IoU >= ``valid_iou``),
-    the best match of each view."""
+def view_matches(candidate: PartCandidate, predictions: dict[str, list[ArticulationPrediction]]
+                 ) -> list[tuple[ArticulationPrediction, str, float]]:
+    """Per top view with a mask, its best-overlapping prediction (first of equals) and that IoU, when > 0:
+    the one pass of mask IoUs that validation and the view consensus both read."""
     out = []
     for view in candidate.top_views:
         if view.mask is None:
             continue
-        scored = [(mask_iou(view.mask.mask, p.mask), p) for p in predictions.get(view.frame_id, [])]
-        if scored:
-            iou, p = max(scored, key=lambda t: t[0])
-            if iou >= valid_iou:
-                out.append((p, view.frame_id))
+        best, best_iou = None, 0.0
+        for p in predictions.get(view.frame_id, []):
+            iou = mask_iou(view.mask.mask, p.mask)
+            if iou > best_iou:
+                best, best_iou = p, iou
+        if best is not None:
+            out.append((best, view.frame_id, best_iou))
     return out
+
+
+def best_prediction(candidate: PartCandidate, predictions: dict[str, list[ArticulationPrediction]],
+                    matches: list[tuple[ArticulationPrediction, str, float]] | None = None
+                    ) -> tuple[ArticulationPrediction | None, float, str | None]:
+    """The prediction with the highest mask IoU over the candidate's top views (and that IoU); ``matches``:
+    :func:`view_matches` already computed."""
+    matches = view_matches(candidate, predictions) if matches is None else matches
+    if not matches:
+        return None, 0.0, None
+    p, view, iou = max(matches, key=lambda m: m[2])
+    return p, iou, view
+
+
+def matching_predictions(candidate: PartCandidate, predictions: dict[str, list[ArticulationPrediction]],
+                         valid_iou: float, matches: list[tuple[ArticulationPrediction, str, float]] | None = None
+                         ) -> list[tuple[ArticulationPrediction, str]]:
+    """Every (prediction, view) whose mask matches the candidate's in one of its top views (IoU >= ``valid_iou``),
+    the best match of each view."""
+    matches = view_matches(candidate, predictions) if matches is None else matches
+    return [(p, view) for p, view, iou in matches if iou >= valid_iou]
 
 
 def consensus_joint(best: Articulation, others: list[Articulation]) -> Articulation:
