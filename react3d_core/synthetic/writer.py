@@ -28,8 +28,9 @@ from .remesh import (LASER_DECIMATION, LASER_VOXEL, MESH_KINDS, TRANSFER_RADIUS,
                      laser_depth, transfer_labels, transfer_parts)
 from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, sensor_depth
 
-# 2: URDF sources keep only observed surfaces; 3: photo realism (default) and laser / TSDF scan meshes
-GENERATOR_VERSION = "3"
+# 2: URDF sources keep only observed surfaces; 3: photo realism (default) and laser / TSDF scan meshes;
+# 4: scene-synthesizer kitchens drop objects stacked on an earlier one (from_scene_synthesizer.py)
+GENERATOR_VERSION = "4"
 
 
 def _gt_parts(layout: SynthLayout) -> tuple[list[GTPart], np.ndarray, list[dict]]:
