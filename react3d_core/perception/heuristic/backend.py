@@ -23,6 +23,7 @@ from ...raster import Rasterizer
 from ...scene_io.images import frame_rgb
 from .facets import planar_facets
 from .fronts import Front, find_fronts
+from .splashback import on_worktop, splashback_from_config
 from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts, params_from_config
 from .sliding import SlidingRules, mark_sliding, sliding_from_config
 
@@ -63,6 +64,9 @@ class HeuristicModel:
             self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, rules, image, taken,
                                            self.fronts)
             self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
+        worktop = splashback_from_config(h)
+        if worktop is not None:  # fronts flush with the wall right above a worktop are splash-back
+            self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, worktop)) if not drop]
         if sliding is not None:
             mark_sliding(self.fronts, sliding)  # two fronts a track apart: sliding doors
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
