@@ -47,6 +47,7 @@ class CellParams:
     step_contrast: float = _H.step_contrast      # a colour step along a whole line (a door leaf in a pale wall): colour distance across it ...
     step_z: float = _H.step_z                    # ... and in noise units of the cell's steps
     max_depth: int = _H.max_split_depth          # guillotine recursion depth
+    step_over_dip: bool = _H.step_over_dip       # a colour step stronger than the best dark line is the edge
 
 
 @dataclass
@@ -309,12 +310,20 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
     ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
     sc_v = sc_v if sc_v >= p.seam_z else 0.0
     sc_h = sc_h if sc_h >= p.seam_z else 0.0
-    straight = int(max(sc_v, sc_h) > 0.0)
-    if not straight:  # a colour step along the whole cell (a front of another colour than its surround)
-        cv_, sc_v = _dip_cut(col[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1], _step_scores)
-        ch_, sc_h = _dip_cut(col[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1], _step_scores)
-        sc_v = sc_v if sc_v >= p.step_z else 0.0
-        sc_h = sc_h if sc_h >= p.step_z else 0.0
+    dip_v, dip_h = sc_v > 0.0, sc_h > 0.0
+    if p.step_over_dip or not (dip_v or dip_h):
+        # a colour step along the whole cell (a front of another colour than its surround or its
+        # neighbour); with ``step_over_dip`` it wins where it is stronger than the best dark line (a
+        # shaker door's frame casts a straight dark line a few cm inside its own edge)
+        sv_, st_v = _dip_cut(col[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1], _step_scores)
+        sh_, st_h = _dip_cut(col[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1], _step_scores)
+        st_v = st_v if st_v >= p.step_z else 0.0
+        st_h = st_h if st_h >= p.step_z else 0.0
+        if st_v > sc_v:
+            cv_, sc_v, dip_v = sv_, st_v, False
+        if st_h > sc_h:
+            ch_, sc_h, dip_h = sh_, st_h, False
+    straight = int(dip_v if sc_v >= sc_h else dip_h) if max(sc_v, sc_h) > 0.0 else 0
     if max(sc_v, sc_h) == 0.0:
         cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])
         ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])

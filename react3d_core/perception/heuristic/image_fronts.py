@@ -45,6 +45,9 @@ class ImageFrontParams:
     protrusion_depth: tuple[float, float] = _H.protrusion_depth  # m in front of the plane: mesh handles
     min_tile_side: float = _H.min_tile_side              # m: handle-less cells smaller than this both ways are tiles, not fronts
     handleless_min_seams: int = _H.handleless_min_seams  # a handle-less cell cut out by this many straight seams is a front (0: never)
+    cell_median_clutter: bool = _H.clutter_cell_median  # clutter also judged against the cell's own median colour
+    line_min_len: float = _H.clutter_line_min_len        # m: straight lines this long (and thin) are a front's structure, not clutter
+    line_max_width: float = _H.clutter_line_max_width    # m
 
 
 def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
@@ -63,12 +66,13 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
                          background_win=cfg.handle_background_win, min_seen=cfg.cell_min_seen,
                          max_clutter=cfg.max_clutter, outline_margin=cfg.handle_outline_margin,
                          texture_factor=cfg.texture_factor, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
-                         step_z=cfg.step_z, max_depth=cfg.max_split_depth),
+                         step_z=cfg.step_z, max_depth=cfg.max_split_depth, step_over_dip=cfg.step_over_dip),
         plane_offset_tol=cfg.plane_offset_tol, plane_angle_tol_deg=cfg.plane_angle_tol_deg,
         min_plane_area=cfg.min_plane_area, plane_cell=cfg.plane_cell, plane_min_fragment_area=cfg.plane_min_fragment_area,
         face_depth=tuple(cfg.face_depth), outline_fill_px=cfg.outline_fill_px,
         protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
-        handleless_min_seams=cfg.handleless_min_seams)
+        handleless_min_seams=cfg.handleless_min_seams, cell_median_clutter=cfg.clutter_cell_median, line_min_len=cfg.clutter_line_min_len,
+        line_max_width=cfg.clutter_line_max_width)
 
 
 @dataclass
@@ -116,6 +120,22 @@ def cov_outline(cov: np.ndarray, px: int = _H.outline_fill_px) -> np.ndarray:
     return cov.astype(bool) | (left & right).astype(bool) | (up & down).astype(bool)
 
 
+def thin_lines(mask: np.ndarray, res: float, min_len: float, max_width: float) -> np.ndarray:
+    """Pixels of ``mask`` on straight horizontal or vertical lines at least ``min_len`` long and at most
+    ``max_width`` thick: the edges of a shaker door's frame and panel, tile joints, seams. They are
+    structure of a front, not clutter on it (a poster or a shelf is a filled blob and stays)."""
+    if min_len <= 0 or not mask.any():
+        return np.zeros(mask.shape, bool)
+    m = mask.astype(np.uint8)
+    L = max(3, int(round(min_len / res)))
+    t = max(2, int(round(max_width / res)) + 1)
+    long_h = cv2.morphologyEx(m, cv2.MORPH_OPEN, np.ones((1, L), np.uint8))
+    long_v = cv2.morphologyEx(m, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
+    thick_v = cv2.morphologyEx(m, cv2.MORPH_OPEN, np.ones((t, 1), np.uint8))  # runs across a horizontal line
+    thick_h = cv2.morphologyEx(m, cv2.MORPH_OPEN, np.ones((1, t), np.uint8))
+    return ((long_h & ~thick_v) | (long_v & ~thick_h)).astype(bool)
+
+
 def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
                    depth: tuple[float, float] = _H.protrusion_depth) -> np.ndarray:
     """Grid pixels under outward-facing faces standing ``depth`` in front of the plane (handles in
@@ -153,9 +173,12 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         diffs.append(diff)
         outline = cov_outline(cov, params.outline_fill_px)  # handle shadows are holes in the plane, not its outline
         handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals, params.protrusion_depth) & outline, outline)
-        clutter = (diff > off_threshold(diff, o.n_views > 0, params.cells)) & (o.n_views > 0)
+        thr = off_threshold(diff, o.n_views > 0, params.cells)
+        clutter = (diff > thr) & (o.n_views > 0)
+        structure = thin_lines(clutter, o.res, params.line_min_len, params.line_max_width)
         for h in handles:  # a handle is not clutter
-            clutter[h.pixels[:, 1], h.pixels[:, 0]] = False
+            structure[h.pixels[:, 1], h.pixels[:, 0]] = True
+        clutter &= ~structure
         p = o.plane
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
@@ -163,7 +186,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         tiled = any(max(c.c1 - c.c0, c.r1 - c.r0) * o.res < params.min_tile_side
                     and cov[c.r0:c.r1, c.c0:c.c1].mean() >= params.cells.min_seen for c in cells)
         for cell in cells:
-            f = _cell_front(o, cell, cov, clutter, in_plane, rules, params, None)
+            f = _cell_front(o, cell, cov, clutter, in_plane, rules, params, None,
+                            (thr, structure) if params.cell_median_clutter else None)
             if f is not None:
                 fronts.append(f)
                 if not tiled and 0 < params.handleless_min_seams <= cell.seam_cuts:
@@ -238,14 +262,36 @@ def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarra
     return False
 
 
+def _clutter_share(o: Orthophoto, cell: Cell, clutter: np.ndarray, seen: np.ndarray,
+                   plain: tuple[float, np.ndarray] | None) -> float:
+    """Share of a cell's seen pixels that are clutter: off their local background (``clutter``), unless
+    they are close to the cell's own median colour (``plain`` = (threshold, structure pixels to leave
+    out)). The local background is a 12 cm median, which on a front beside a front of another colour
+    (or a dark gap) takes the neighbour's colour in a band along every edge; the cell's own median
+    does not, while a poster or a shelf still differs from the wall around it."""
+    sl = (slice(cell.r0, cell.r1), slice(cell.c0, cell.c1))
+    share = float(clutter[sl][seen].mean())
+    if plain is None:
+        return share
+    thr, structure = plain
+    keep = seen & ~structure[sl]
+    if keep.sum() < 50:
+        return share
+    col = o.color[sl]
+    med = np.median(col[keep], axis=0)
+    off = np.linalg.norm(col - med, axis=-1) > thr
+    return min(share, float(off[keep].mean()))
+
+
 def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, in_plane: np.ndarray, rules: FrontRules,
-                params: ImageFrontParams, taken: np.ndarray | None) -> Front | None:
+                params: ImageFrontParams, taken: np.ndarray | None,
+                plain: tuple[float, np.ndarray] | None = None) -> Front | None:
     """The front of one cell, or None when the cell is not door/drawer-like."""
     sub = cov[cell.r0:cell.r1, cell.c0:cell.c1]
     if sub.size == 0 or sub.mean() < params.cells.min_seen:
         return None
     seen = o.n_views[cell.r0:cell.r1, cell.c0:cell.c1] > 0
-    if seen.any() and clutter[cell.r0:cell.r1, cell.c0:cell.c1][seen].mean() > params.cells.max_clutter:
+    if seen.any() and _clutter_share(o, cell, clutter, seen, plain) > params.cells.max_clutter:
         return None  # posters, tiles, shelves: a front is a plain panel
     rows, cols = np.nonzero(sub)
     c0, c1 = cell.c0 + cols.min(), cell.c0 + cols.max() + 1   # tighten to the covered area

@@ -288,3 +288,62 @@ def test_colour_step_cuts_a_door_leaf_out_of_a_wall() -> None:
     cells = split_cells(o, cov, handles, CellParams())
     leaf = [c for c in cells if c.handles]
     assert len(leaf) == 1 and abs(leaf[0].c0 - 160) <= 2 and abs(leaf[0].c1 - 340) <= 2
+
+
+def test_thin_lines_are_structure_not_clutter() -> None:
+    """At 1 cm per pixel, min length 0.15 m (15 px), max width 0.02 m: a 1 px x 60 px line and a 2 px x
+    40 px vertical line are structure; a 20 x 20 px blob (a poster) and a 1 x 10 px dash are not."""
+    from react3d_core.perception.heuristic.image_fronts import thin_lines
+
+    m = np.zeros((80, 100), bool)
+    m[10, 5:65] = True            # long thin horizontal line
+    m[20:60, 80:82] = True        # long thin vertical line, 2 px wide
+    m[40:60, 20:40] = True        # filled blob
+    m[70, 50:60] = True           # short dash
+    lines = thin_lines(m, 0.01, 0.15, 0.02)
+    assert lines[10, 5:65].all() and lines[20:60, 80:82].all()
+    assert not lines[40:60, 20:40].any() and not lines[70, 50:60].any()
+    assert not thin_lines(m, 0.01, 0.0, 0.02).any()   # 0 turns it off
+
+
+def test_clutter_share_against_the_cell_colour() -> None:
+    """A plain red door cell whose local-background map flags a band along one edge (the neighbour's
+    colour leaks into the 12 cm median) is not cluttered by its own colour: share min(0.3, 0.0) = 0.
+    With a blue poster over 30 % of the cell it is: both measures say 0.3."""
+    from react3d_core.perception.heuristic.front_cells import Cell
+    from react3d_core.perception.heuristic.image_fronts import _clutter_share
+
+    h, w = 50, 40
+    img = np.tile(np.array([1.4, 0.3, 0.3], np.float32), (h, w, 1))
+    o = _ortho(img, 0.01)
+    cell = Cell(0, 0, w, h)
+    band = np.zeros((h, w), bool)
+    band[:, :12] = True                                   # 12 of 40 columns: 0.3
+    seen = np.ones((h, w), bool)
+    none = np.zeros((h, w), bool)
+    assert _clutter_share(o, cell, band, seen, None) == pytest.approx(0.3)
+    assert _clutter_share(o, cell, band, seen, (0.12, none)) == pytest.approx(0.0)
+    img[:, :12] = [0.3, 0.3, 1.4]                         # a poster where the band is
+    o = _ortho(img, 0.01)
+    assert _clutter_share(o, cell, band, seen, (0.12, none)) == pytest.approx(0.3)
+
+
+def test_colour_step_beats_a_weaker_frame_line() -> None:
+    """Two shaker doors of different colours meet at column 100 (a colour step, no dark gap); inside
+    the right door its frame casts a dark line at column 116. With ``step_over_dip`` the cut is the
+    colour step (the doors' edge); without it, the dark line wins and the cut lands 16 px inside the door."""
+    h, w = 160, 200
+    rng = np.random.default_rng(3)
+    img = np.empty((h, w, 3), np.float32)
+    img[:, :100] = [0.6, 1.2, 0.6]                        # green door
+    img[:, 100:] = [1.3, 1.2, 0.5]                        # yellow door
+    img += rng.normal(0, 0.01, img.shape).astype(np.float32)
+    img[:, 116] *= 0.8                                    # the frame's shadow line
+    o = _ortho(img, 0.004)
+    cov = np.ones((h, w), bool)
+    on = CellParams(min_front=0.12, step_over_dip=True)
+    off = CellParams(min_front=0.12, step_over_dip=False)
+    cuts_on = sorted({c.c0 for c in split_cells(o, cov, [], on)} - {0})
+    cuts_off = sorted({c.c0 for c in split_cells(o, cov, [], off)} - {0})
+    assert cuts_on and abs(cuts_on[0] - 100) <= 2, cuts_on
+    assert cuts_off and abs(cuts_off[0] - 117) <= 2, cuts_off
