@@ -71,8 +71,8 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
         min_plane_area=cfg.min_plane_area, plane_cell=cfg.plane_cell, plane_min_fragment_area=cfg.plane_min_fragment_area,
         face_depth=tuple(cfg.face_depth), outline_fill_px=cfg.outline_fill_px,
         protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
-        handleless_min_seams=cfg.handleless_min_seams, cell_median_clutter=cfg.clutter_cell_median, line_min_len=cfg.clutter_line_min_len,
-        line_max_width=cfg.clutter_line_max_width)
+        handleless_min_seams=cfg.handleless_min_seams, cell_median_clutter=cfg.clutter_cell_median,
+        line_min_len=cfg.clutter_line_min_len, line_max_width=cfg.clutter_line_max_width)
 
 
 @dataclass
