@@ -30,16 +30,11 @@ from react3d_core.atomic import write_json  # noqa: E402
 def sam_spec(variant: str, tiny: bool) -> tuple[Callable[[], Any], Callable[[Any, int, Any, Any], Any]]:
     """(build, run) for a SAM image encoder; run(model, batch, device, dtype) does one forward."""
     import torch
-    from transformers import SamConfig, SamModel
+    from transformers import SamModel
 
-    if tiny:
-        vc = dict(hidden_size=32, num_hidden_layers=1, num_attention_heads=2, image_size=64, patch_size=8,
-                  output_channels=16, mlp_dim=32, global_attn_indexes=[0], window_size=4, num_pos_feats=8)
-    else:
-        vc = {"vit_h": dict(hidden_size=1280, num_hidden_layers=32, num_attention_heads=16, global_attn_indexes=[7, 15, 23, 31]),
-              "vit_b": dict(hidden_size=768, num_hidden_layers=12, num_attention_heads=12, global_attn_indexes=[2, 5, 8, 11])}[variant]
-    cfg = SamConfig(vision_config=vc, prompt_encoder_config=dict(hidden_size=vc.get("output_channels", 256),
-                                                                 image_size=vc.get("image_size", 1024), patch_size=vc.get("patch_size", 16)))
+    from tasks.models.random_checkpoints import sam_config
+
+    cfg = sam_config("tiny" if tiny else "real", variant)
     size = cfg.vision_config.image_size
 
     def build() -> Any:
@@ -53,20 +48,14 @@ def sam_spec(variant: str, tiny: bool) -> tuple[Callable[[], Any], Callable[[Any
 
 
 def gdino_spec(tiny: bool) -> tuple[Callable[[], Any], Callable[[Any, int, Any, Any], Any]]:
+    """(build, run) for Grounding DINO-T at 800x1066 with a 16-token prompt (tiny: 64x96)."""
     import torch
-    from transformers import BertConfig, GroundingDinoConfig, GroundingDinoForObjectDetection, SwinConfig
+    from transformers import GroundingDinoForObjectDetection
 
-    if tiny:
-        cfg = GroundingDinoConfig(
-            backbone_config=SwinConfig(image_size=64, patch_size=4, embed_dim=16, depths=[1, 1, 1, 1], num_heads=[1, 1, 1, 1],
-                                       window_size=4, out_indices=[2, 3, 4]),
-            text_config=BertConfig(vocab_size=64, hidden_size=32, num_hidden_layers=1, num_attention_heads=2,
-                                   intermediate_size=32, max_position_embeddings=64),
-            d_model=32, encoder_layers=1, decoder_layers=2, encoder_ffn_dim=32, decoder_ffn_dim=32, encoder_attention_heads=2,
-            decoder_attention_heads=2, num_queries=20, encoder_n_points=2, decoder_n_points=2, max_text_len=32)
-        hw = (64, 96)
-    else:
-        cfg, hw = GroundingDinoConfig(), (800, 1066)  # defaults = Grounding DINO-T (Swin-T, BERT-base, 900 queries)
+    from tasks.models.random_checkpoints import detector_config
+
+    cfg = detector_config("tiny" if tiny else "real")
+    hw = (64, 96) if tiny else (800, 1066)
 
     def build() -> Any:
         return GroundingDinoForObjectDetection(cfg).eval()
@@ -97,15 +86,19 @@ def bench_one(name: str, build: Callable[[], Any], run: Callable[..., Any], devi
     """Reference (fp32, batch 1, rebuilt per call) versus ours (built once, dtype, batched)."""
     import torch
 
+    def build_on() -> Any:  # random initialisation on the device itself (ViT-H on a CPU takes tens of seconds)
+        with device:
+            return build()
+
     with torch.inference_mode():
         # reference forward-only: fp32, batch 1 (model built once here so only the forward is timed)
-        ref = build().to(device)
+        ref = build_on().to(device)
         run(ref, 1, device, torch.float32)  # warm-up
         t_fwd = sum(timed(lambda: run(ref, 1, device, torch.float32), device) for _ in range(n_images))
         del ref
         # reference with rebuild per call
-        t_rb = sum(timed(lambda: run(build().to(device), 1, device, torch.float32), device) for _ in range(rebuild_calls))
-        ours = build().to(device=device, dtype=dtype)
+        t_rb = sum(timed(lambda: run(build_on().to(device), 1, device, torch.float32), device) for _ in range(rebuild_calls))
+        ours = build_on().to(device=device, dtype=dtype)
         if device.type == "cuda":
             torch.cuda.reset_peak_memory_stats(device)
         run(ours, batch, device, dtype)  # warm-up

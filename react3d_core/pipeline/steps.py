@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -78,8 +79,18 @@ def split_on_oom(fn: Callable[[list[Any], list[Any]], list[T]], frames: list[Any
     except Exception as exc:  # noqa: BLE001 - only OOM is handled, everything else re-raised
         if not _is_oom(exc) or len(frames) == 1:
             raise
-        h = len(frames) // 2
-        return split_on_oom(fn, frames[:h], images[:h]) + split_on_oom(fn, frames[h:], images[h:])
+    # Outside the except block: the failed attempt's traceback (and the GPU tensors its frames hold) is
+    # gone before the halves run, and the allocator's cached blocks are returned.
+    _release_gpu_cache()
+    h = len(frames) // 2
+    return split_on_oom(fn, frames[:h], images[:h]) + split_on_oom(fn, frames[h:], images[h:])
+
+
+def _release_gpu_cache() -> None:
+    """torch.cuda.empty_cache() when torch is loaded (the core itself never imports it)."""
+    torch = sys.modules.get("torch")
+    if torch is not None and torch.cuda.is_available():
+        torch.cuda.empty_cache()
 
 
 def perceive(perception: Perception, frames: Sequence[Frame], cfg: PerceptionConfig) -> dict[str, Any]:

@@ -67,9 +67,10 @@ def make_model_perception(config: PerceptionConfig) -> Perception:
         articulation = NoArticulationPredictor()
     return Perception(
         name="models",
-        tagger=ClipTagger(clip, opts.tag_vocabulary, opts.tag_top_k, opts.tag_min_prob, config.batch_size),
+        tagger=ClipTagger(clip, opts.tag_vocabulary, opts.tag_top_k, opts.tag_min_prob, config.batch_size, opts.gpu_preprocess),
         tag_filter=CachedTagFilter(ask, config.always_keep_tags, retries, opts.llm_backoff_s),
-        segmenter=GroundedSamSegmenter(det, sam, config.box_threshold, config.text_threshold, config.batch_size),
+        segmenter=GroundedSamSegmenter(det, sam, config.box_threshold, config.text_threshold, config.batch_size,
+                                        max_detections=opts.max_detections, gpu_preprocess=opts.gpu_preprocess),
         point_segmenter=SamPointSegmenter(sam),
         articulation=articulation,
         version=STAGE_VERSION,

@@ -34,6 +34,8 @@ class ModelOptions(BaseModel):
     llm_retries: int = Field(3, ge=0, description="Retries after a failed/malformed chat reply.")
     llm_backoff_s: float = Field(1.0, ge=0, description="First retry delay; doubles each retry.")
     llm_max_new_tokens: int = Field(256, ge=8, description="Reply length of the local tag-filter LM.")
+    max_detections: int = Field(100, ge=1, description="At most this many boxes per frame after NMS (each costs a full-size mask).")
+    gpu_preprocess: bool = Field(True, description="Resize/normalise frames on the GPU when the processors have a torch backend.")
     articulation_timeout_s: float = Field(300.0, gt=0, description="Timeout of one OPDMulti request/command.")
     articulation_min_score: float = Field(0.5, ge=0, le=1, description="OPDMulti predictions below this score are dropped.")
 

@@ -15,7 +15,7 @@ import torch
 
 from react3d_core.data.frames import Frame
 
-from .runtime import Loaded
+from .runtime import Loaded, preprocess, to_model
 
 
 def select_tags(probs: np.ndarray, vocabulary: Sequence[str], top_k: int, min_prob: float) -> list[list[str]]:
@@ -27,10 +27,11 @@ def select_tags(probs: np.ndarray, vocabulary: Sequence[str], top_k: int, min_pr
 class ClipTagger:
     """Tagger protocol on CLIP image/text embeddings (batched images, text embedded once)."""
 
-    def __init__(self, clip: Loaded, vocabulary: Sequence[str], top_k: int, min_prob: float, batch_size: int) -> None:
+    def __init__(self, clip: Loaded, vocabulary: Sequence[str], top_k: int, min_prob: float, batch_size: int,
+                 gpu_preprocess: bool = True) -> None:
         if not vocabulary:
             raise ValueError("the tag vocabulary is empty")
-        self.clip, self.vocabulary = clip, list(vocabulary)
+        self.clip, self.vocabulary, self.gpu_preprocess = clip, list(vocabulary), gpu_preprocess
         self.top_k, self.min_prob, self.batch_size = top_k, min_prob, batch_size
         self._text: torch.Tensor | None = None
 
@@ -49,9 +50,10 @@ class ClipTagger:
         text = self._text_embeddings()
         rows = []
         for s in range(0, len(images), self.batch_size):
-            px = self.clip.processor(images=list(images[s : s + self.batch_size]), return_tensors="pt")["pixel_values"]
+            px = preprocess(self.clip.processor, self.clip.device, self.gpu_preprocess,
+                            images=list(images[s : s + self.batch_size]))["pixel_values"]
             with torch.inference_mode():
-                v = self.clip.model.get_image_features(pixel_values=px.to(self.clip.device, self.clip.dtype))
+                v = self.clip.model.get_image_features(**to_model({"pixel_values": px}, self.clip.device, self.clip.dtype))
                 v = torch.nn.functional.normalize(getattr(v, "pooler_output", v).float(), dim=-1)
                 scale = self.clip.model.logit_scale.exp().float()
                 rows.append(torch.softmax(scale * v @ text.T, dim=-1).cpu().numpy())

@@ -28,8 +28,7 @@ transformers = pytest.importorskip("transformers")
 torch.set_num_threads(1)
 
 from react3d_core.data.frames import Frame, ImageRef, Intrinsics  # noqa: E402
-
-WORDS = "[PAD] [UNK] [CLS] [SEP] [MASK] . a photo of cabinet door drawer oven wardrobe table chair floor".split()
+from tasks.models.random_checkpoints import save_random_checkpoints  # noqa: E402
 
 
 def make_frame(frame_id: str, h: int, w: int) -> Frame:
@@ -44,53 +43,10 @@ def make_image(h: int, w: int, seed: int) -> np.ndarray:
     return img
 
 
-def _bert_tokenizer() -> Any:
-    return transformers.BertTokenizer(vocab={w: i for i, w in enumerate(WORDS)})
-
-
 @pytest.fixture(scope="session")
 def tiny_models(tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
     """Folders with save_pretrained() tiny detector / SAM / CLIP (a few layers, 16-32 dims)."""
-    root = tmp_path_factory.mktemp("tiny_models")
-    torch.manual_seed(0)
-    tf = transformers
-    # Grounding DINO: Swin backbone 64 px, 1-layer BERT text tower, 2 decoder layers (1 breaks weight tying).
-    det = root / "gdino"
-    det.mkdir()
-    tok = _bert_tokenizer()
-    cfg = tf.GroundingDinoConfig(
-        backbone_config=tf.SwinConfig(image_size=64, patch_size=4, embed_dim=16, depths=[1, 1, 1, 1], num_heads=[1, 1, 1, 1],
-                                      window_size=4, out_indices=[2, 3, 4]),
-        text_config=tf.BertConfig(vocab_size=len(WORDS), hidden_size=32, num_hidden_layers=1, num_attention_heads=2,
-                                  intermediate_size=32, max_position_embeddings=64),
-        d_model=32, encoder_layers=1, decoder_layers=2, encoder_ffn_dim=32, decoder_ffn_dim=32, encoder_attention_heads=2,
-        decoder_attention_heads=2, num_queries=20, num_feature_levels=4, encoder_n_points=2, decoder_n_points=2, max_text_len=32)
-    tf.GroundingDinoForObjectDetection(cfg).save_pretrained(det)
-    ip = tf.GroundingDinoImageProcessor(size={"shortest_edge": 64, "longest_edge": 96})
-    tf.GroundingDinoProcessor(image_processor=ip, tokenizer=tok).save_pretrained(det)
-    # SAM: 64 px input, 8 px patches -> 8x8 embeddings, 16 channels.
-    sam = root / "sam"
-    scfg = tf.SamConfig(
-        vision_config=dict(hidden_size=32, num_hidden_layers=1, num_attention_heads=2, image_size=64, patch_size=8,
-                           output_channels=16, mlp_dim=32, global_attn_indexes=[0], window_size=4, num_pos_feats=8),
-        prompt_encoder_config=dict(hidden_size=16, image_size=64, patch_size=8, mask_input_channels=4),
-        mask_decoder_config=dict(hidden_size=16, num_hidden_layers=1, num_attention_heads=2, mlp_dim=32, iou_head_hidden_dim=16))
-    tf.SamModel(scfg).save_pretrained(sam)
-    tf.SamProcessor(image_processor=tf.SamImageProcessor(size={"longest_edge": 64}, pad_size={"height": 64, "width": 64},
-                                                          mask_size={"longest_edge": 32})).save_pretrained(sam)
-    # CLIP: 32 px images, 1-layer towers, the same word-level vocabulary.
-    clip = root / "clip"
-    clip.mkdir()
-    ctok = _bert_tokenizer()
-    ccfg = tf.CLIPConfig(
-        text_config=dict(vocab_size=len(WORDS), hidden_size=16, intermediate_size=32, num_hidden_layers=1, num_attention_heads=2,
-                         max_position_embeddings=32, bos_token_id=2, eos_token_id=3, pad_token_id=0),
-        vision_config=dict(hidden_size=16, intermediate_size=32, num_hidden_layers=1, num_attention_heads=2, image_size=32, patch_size=8),
-        projection_dim=16)
-    tf.CLIPModel(ccfg).save_pretrained(clip)
-    tf.CLIPProcessor(image_processor=tf.CLIPImageProcessor(size={"shortest_edge": 32}, crop_size={"height": 32, "width": 32}),
-                     tokenizer=ctok).save_pretrained(clip)
-    return {"detector": det, "sam": sam, "clip": clip}
+    return save_random_checkpoints(tmp_path_factory.mktemp("tiny_models"), "tiny")
 
 
 class FakeServer:

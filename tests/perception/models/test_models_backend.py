@@ -98,6 +98,26 @@ def test_benchmark_runs_tiny(tmp_path):
     assert all(r["ours_img_s"] > 0 and r["ref_fp32_b1_img_s"] > 0 and r["ref_rebuild_img_s"] > 0 for r in rows)
 
 
+def test_scene_benchmark_runs_tiny(tmp_path):
+    """benchmarks/bench_models_scene.py --quick on tiny models (CPU): the stage over real JPEG files,
+    every frame accounted for, masks capped per frame, reference timings present."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "bench_models_scene.py"
+    spec = importlib.util.spec_from_file_location("bench_models_scene", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = tmp_path / "s.json"
+    assert mod.main(["--tiny", "--quick", "--frames", "4", "--width", "96", "--height", "72", "--batch", "2", "--workers", "2",
+                     "--ref-frames", "1", "--max-detections", "3", "--box-threshold", "0.0", "--work", str(tmp_path / "w"),
+                     "--json", str(out)]) == 0
+    r = json.loads(out.read_text())
+    assert r["tiny"] and r["runs"]["ours"]["frames"] == 4 and 0 < r["runs"]["ours"]["masks"] <= 4 * 3
+    assert r["ref_fp32_b1_forward_s_per_frame"] > 0 and r["speedup_vs_ref_rebuild"] > 0
+    assert set(r["per_call_ms_per_frame"]["batch2"]) >= {"grounding_dino", "sam_encoder", "sam_decoder_masks"}
+
+
 def test_local_lm_tag_filter_path(tmp_path):
     """A tiny random Llama through the local-LM path: loads, generates, decodes; its gibberish is
     unreadable, so only 'door' survives (the documented fallback)."""

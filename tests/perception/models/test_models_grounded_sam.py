@@ -146,3 +146,30 @@ def test_box_nms_hand_computed():
     assert box_nms(boxes, scores, 0.5).tolist() == [1, 2]
     assert box_nms(boxes, scores, 0.8).tolist() == [1, 2, 0]
     assert box_nms(np.zeros((0, 4)), np.zeros(0), 0.8).tolist() == []
+
+
+def test_top_queries_keeps_the_best_scored_queries_hand_computed():
+    from tasks.models.grounded_sam import top_queries
+
+    # 1 image, 4 queries, 2 tokens: best token logits 0.1, 2.0, -1.0, 1.5 -> keep queries 1 and 3, best first
+    logits = torch.tensor([[[0.1, -3.0], [2.0, 0.0], [-1.0, -2.0], [-5.0, 1.5]]])
+    boxes = torch.arange(16, dtype=torch.float32).reshape(1, 4, 4)
+    lg, bx = top_queries(logits, boxes, 2)
+    assert lg.tolist() == [[[2.0, 0.0], [-5.0, 1.5]]]
+    assert bx.tolist() == [[[4.0, 5.0, 6.0, 7.0], [12.0, 13.0, 14.0, 15.0]]]
+    assert top_queries(logits, boxes, 0)[0] is logits and top_queries(logits, boxes, 4)[1] is boxes
+
+
+def test_batched_decoder_equals_one_call_per_frame(loaded, make_image):
+    """Frames with 1 and 3 boxes decoded together (padded) give the masks of one decoder call per frame."""
+    from tasks.models.grounded_sam import sam_box_masks, sam_box_masks_batched, sam_image_embeddings
+
+    _, sam = loaded
+    images = [make_image(60, 80, 0), make_image(60, 80, 1)]
+    emb, inputs = sam_image_embeddings(sam, images)
+    boxes = [np.array([[10.0, 5.0, 50.0, 40.0]]), np.array([[0.0, 0.0, 30.0, 30.0], [20.0, 10.0, 70.0, 55.0], [5.0, 5.0, 15.0, 15.0]])]
+    together = sam_box_masks_batched(sam, emb, inputs, boxes)
+    apart = [sam_box_masks(sam, emb, inputs, i, b) for i, b in enumerate(boxes)]
+    assert [t.shape for t in together] == [(1, 60, 80), (3, 60, 80)]
+    for t, a in zip(together, apart):
+        assert (t == a).mean() > 0.999
