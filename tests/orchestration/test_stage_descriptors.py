@@ -92,7 +92,7 @@ def test_perception_keys_name_the_model_backend_only_when_it_is_used() -> None:
 
     assert model_backend_version(BASE) == {}
     models = {**BASE, "perception": {**BASE["perception"], "backend": "models"}}
-    assert model_backend_version(models) == {"tasks.models": "1"}
+    assert model_backend_version(models) == {"tasks.models": "2"}
     code = ("import sys; from tasks.perception import perceive_frames; from tasks.keys import step_key; "
             "from react3d_core.config import PipelineConfig; "
             "step_key('perception', {'config': PipelineConfig().model_dump(mode='json')}); print('torch' in sys.modules)")
