@@ -3,7 +3,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 
 # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames; 4: sliding doors;
 # 5: straight seams by line median, handle shadows filled, texture-adaptive clutter; 6: splash-back rule,
-# colour steps beat weaker dark lines, line structure and the cell's own colour in the clutter test
-HEURISTIC_VERSION = "6"
+# colour steps beat weaker dark lines, line structure and the cell's own colour in the clutter test;
+# 7: enclosed handle-shaped unseen holes are handles (wall-cabinet flaps), mirrored background border
+HEURISTIC_VERSION = "7"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -128,8 +128,12 @@ def off_background(o: Orthophoto, p: CellParams) -> np.ndarray:
         return np.zeros(valid.shape, np.float32)
     c = np.clip(o.color * 128, 0, 255).astype(np.uint8)
     c[~valid] = np.median(c[valid], axis=0).astype(np.uint8)  # unseen pixels must not look like blobs
-    k = max(3, int(p.background_win / o.res) | 1)
-    bg = cv2.medianBlur(c, min(k, 255))
+    k = min(max(3, int(p.background_win / o.res) | 1), 255)
+    # mirrored, not replicated, beyond the orthophoto's border: medianBlur repeats the last row, so a dark
+    # band along a wall cabinet's bottom edge filled half the window of a flap's handle 5 cm above it
+    # and the bar matched its "background"
+    r = k // 2
+    bg = cv2.medianBlur(cv2.copyMakeBorder(c, r, r, r, r, cv2.BORDER_REFLECT_101), k)[r:-r, r:-r]
     return np.linalg.norm(c.astype(np.float32) - bg.astype(np.float32), axis=-1) / 128.0
 
 

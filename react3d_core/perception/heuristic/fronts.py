@@ -42,6 +42,7 @@ class Front:
     faces: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     frame_facets: list[int] = field(default_factory=list)  # the other facets of a frame-and-panel front
     handle_points: np.ndarray | None = None  # handle seen in the images only (points on the front), else None
+    shadow_points: np.ndarray | None = None  # a handle's scanning shadow on a front without a seen handle (joint only)
 
     @property
     def w(self) -> float:

@@ -20,7 +20,7 @@ from ...config.perception import HeuristicConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
-from .front_cells import Cell, CellParams, find_handles, off_background, off_threshold, split_cells
+from .front_cells import Cell, CellParams, Handle, find_handles, off_background, off_threshold, split_cells
 from .fronts import Front, FrontRules, _joint, _neighbours, doors_in_rows
 from .orthophoto import ColourCalibration, Orthophoto, OrthoParams, build_orthophotos
 from .planes import Plane, vertical_planes
@@ -48,6 +48,7 @@ class ImageFrontParams:
     cell_median_clutter: bool = _H.clutter_cell_median  # clutter also judged against the cell's own median colour
     line_min_len: float = _H.clutter_line_min_len        # m: straight lines this long (and thin) are a front's structure, not clutter
     line_max_width: float = _H.clutter_line_max_width    # m
+    handle_shadows: bool = _H.handle_shadows            # enclosed unseen handle-shaped holes are handles
 
 
 def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
@@ -72,7 +73,7 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
         face_depth=tuple(cfg.face_depth), outline_fill_px=cfg.outline_fill_px,
         protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
         handleless_min_seams=cfg.handleless_min_seams, cell_median_clutter=cfg.clutter_cell_median,
-        line_min_len=cfg.clutter_line_min_len, line_max_width=cfg.clutter_line_max_width)
+        line_min_len=cfg.clutter_line_min_len, line_max_width=cfg.clutter_line_max_width, handle_shadows=cfg.handle_shadows)
 
 
 @dataclass
@@ -103,6 +104,32 @@ def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = _H.plane_min_fr
     n, lab, stats, _ = cv2.connectedComponentsWithStats(cov, connectivity=8)
     keep = np.zeros(n, bool)
     keep[1:] = stats[1:, cv2.CC_STAT_AREA] * o.res ** 2 >= min_area
+    return keep[lab]
+
+
+def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick: float = 0.03,
+                   row_limit: int | None = None) -> np.ndarray:
+    """Horizontal unseen holes inside the outline, at least ``min_thick`` tall, that do not reach the
+    outline's border (and, with ``row_limit``, lie wholly above that orthophoto row).
+
+    A bar handle hides the front just behind and above it from every view that looks up at it (wall
+    cabinets), so on a scan its footprint is a handle-shaped hole with the handle's colour nowhere in
+    the orthophoto; find_handles judges the holes' size and shape like colour blobs. Vertical and thin
+    holes are left out: those are the unseen gaps between fronts. Below eye level the views look down
+    on a bar and see its colour; holes there are left to the colour test."""
+    hole = (outline & ~seen).astype(np.uint8)
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(hole, connectivity=8)
+    if n <= 1:
+        return np.zeros(seen.shape, bool)
+    border = cv2.dilate((~outline).astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    border[[0, -1], :] = True
+    border[:, [0, -1]] = True
+    w, h = stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]
+    keep = (w >= h) & (h * res >= min_thick)
+    if row_limit is not None:
+        keep &= stats[:, cv2.CC_STAT_TOP] + h <= row_limit
+    keep[0] = False
+    keep[np.unique(lab[border & hole.astype(bool)])] = False
     return keep[lab]
 
 
@@ -173,6 +200,11 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         diffs.append(diff)
         outline = cov_outline(cov, params.outline_fill_px)  # handle shadows are holes in the plane, not its outline
         handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals, params.protrusion_depth) & outline, outline)
+        shadows: list[Handle] = []
+        if params.handle_shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
+            eye_row = int(np.floor((o.v_top - float(np.median(cams[:, 2]))) / o.res))  # cameras' median height
+            holes = enclosed_holes(o.n_views > 0, outline, o.res, row_limit=eye_row)
+            shadows = find_handles(o, cov, params.cells, np.zeros_like(diff), holes, outline) if holes.any() else []
         thr = off_threshold(diff, o.n_views > 0, params.cells)
         clutter = (diff > thr) & (o.n_views > 0)
         structure = thin_lines(clutter, o.res, params.line_min_len, params.line_max_width)
@@ -189,6 +221,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
             f = _cell_front(o, cell, cov, clutter, in_plane, rules, params, None,
                             (thr, structure) if params.cell_median_clutter else None)
             if f is not None:
+                if f.handle_points is None:
+                    f.shadow_points = _shadow_in_cell(o, cell, shadows)
                 fronts.append(f)
                 if not tiled and 0 < params.handleless_min_seams <= cell.seam_cuts:
                     gridded.add(id(f))
@@ -199,11 +233,20 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded
               or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
     for f in fronts:
-        hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else None
+        hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else f.shadow_points
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, params)})
     return ImageFronts(fronts, vetoed, planes, orthos, calib)
+
+
+def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.ndarray | None:
+    """World points of the largest handle shadow whose box centre lies in ``cell`` (None: no shadow)."""
+    inside = [h for h in shadows if cell.c0 <= 0.5 * (h.box[0] + h.box[2]) < cell.c1 and cell.r0 <= 0.5 * (h.box[1] + h.box[3]) < cell.r1]
+    if not inside:
+        return None
+    h = max(inside, key=lambda hd: len(hd.pixels))
+    return o.plane.to_world(*o.to_uv(h.pixels[:, 0], h.pixels[:, 1]))
 
 
 def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh_fronts: Sequence[Front],

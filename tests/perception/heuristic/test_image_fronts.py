@@ -347,3 +347,67 @@ def test_colour_step_beats_a_weaker_frame_line() -> None:
     cuts_off = sorted({c.c0 for c in split_cells(o, cov, [], off)} - {0})
     assert cuts_on and abs(cuts_on[0] - 100) <= 2, cuts_on
     assert cuts_off and abs(cuts_off[0] - 117) <= 2, cuts_off
+
+
+def test_enclosed_handle_shadows_hand_computed() -> None:
+    """Unseen holes in a 0.6 x 0.4 m plane (5 mm px): a horizontal 0.2 x 0.04 m hole inside (a bar's
+    shadow seen from below) is kept; a vertical hole (a gap between fronts), a 1 cm thin horizontal one
+    and one open to the outline's border are not."""
+    from react3d_core.perception.heuristic.image_fronts import enclosed_holes
+
+    h, w = 80, 120
+    outline = np.zeros((h, w), bool)
+    outline[5:75, 5:115] = True
+    seen = outline.copy()
+    seen[60:68, 20:60] = False   # 0.2 m x 0.04 m, enclosed: a handle's shadow
+    seen[10:50, 80:86] = False   # vertical: 0.2 m tall, 0.03 m wide
+    seen[20:22, 20:60] = False   # horizontal but 1 cm thin
+    seen[70:75, 70:100] = False  # reaches the outline's bottom border
+    holes = enclosed_holes(seen, outline, 0.005)
+    expected = np.zeros((h, w), bool)
+    expected[60:68, 20:60] = True
+    assert np.array_equal(holes, expected)
+
+
+def test_handle_found_from_its_shadow_alone() -> None:
+    """A plain front whose bar handle left only an unseen hole (no colour anywhere): with the hole as
+    handle evidence find_handles reports one horizontal handle there; without it, none."""
+    from react3d_core.perception.heuristic.image_fronts import enclosed_holes
+
+    h, w = 140, 100
+    img = np.full((h, w, 3), 1.0, np.float32)
+    o = _ortho(img)
+    o.n_views[110:118, 30:70] = 0  # 0.2 x 0.04 m, 0.11 m above the bottom edge
+    cov = np.ones((h, w), bool)
+    p = CellParams()
+    assert find_handles(o, cov, p) == []
+    hs = find_handles(o, cov, p, None, enclosed_holes(o.n_views > 0, cov, o.res), cov)
+    assert len(hs) == 1 and hs[0].horizontal and hs[0].box == (30, 110, 70, 118)
+
+
+def test_handle_shadows_only_above_eye_level() -> None:
+    """The same enclosed hole counts only when it lies wholly above the row of the cameras' height."""
+    from react3d_core.perception.heuristic.image_fronts import enclosed_holes
+
+    outline = np.ones((40, 60), bool)
+    outline[[0, -1], :] = False
+    seen = outline.copy()
+    seen[20:28, 10:50] = False
+    assert enclosed_holes(seen, outline, 0.005, row_limit=28).sum() == 8 * 40
+    assert enclosed_holes(seen, outline, 0.005, row_limit=27).sum() == 0
+
+
+def test_shadow_in_cell_picks_the_largest_shadow_centred_in_it() -> None:
+    """Shadows centred in the cell [0,50)x[0,40): the larger one's pixels come back as points on the
+    plane (5 mm px, plane y=0 facing -y, v_top 0.2 m); a shadow centred outside is ignored; no shadow -> None."""
+    from react3d_core.perception.heuristic.front_cells import Cell, Handle
+    from react3d_core.perception.heuristic.image_fronts import _shadow_in_cell
+
+    o = _ortho(np.ones((40, 100, 3), np.float32))
+    small = Handle((5, 30, 25, 34), True, np.array([[c, r] for r in range(30, 34) for c in range(5, 25)]))
+    big = Handle((10, 20, 40, 26), True, np.array([[c, r] for r in range(20, 26) for c in range(10, 40)]))
+    outside = Handle((45, 5, 95, 15), True, np.array([[c, r] for r in range(5, 15) for c in range(45, 95)]))
+    pts = _shadow_in_cell(o, Cell(0, 0, 50, 40), [small, big, outside])
+    assert pts.shape == (6 * 30, 3)
+    assert np.allclose(pts[0], [10.5 * 0.005, 0.0, 0.2 - 20.5 * 0.005])
+    assert _shadow_in_cell(o, Cell(0, 0, 50, 40), []) is None
