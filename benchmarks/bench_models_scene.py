@@ -246,7 +246,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--box-threshold", type=float, default=0.3)
     p.add_argument("--sam", default="vit_h", choices=["vit_h", "vit_b"])
     p.add_argument("--quick", action="store_true", help="only the whole-scene run, one per-call batch and the reference")
-    p.add_argument("--work", default=None, help="folder for checkpoints and frames (default: a temporary one)")
+    p.add_argument("--work", default=None, help="a new or empty folder for checkpoints and frames (default: a temporary one)")
     p.add_argument("--json", default=None)
     a = p.parse_args(argv)
 
@@ -263,6 +263,8 @@ def main(argv: list[str] | None = None) -> int:
     device = torch.device("cuda" if gpu else "cpu")
     if not gpu:
         torch.set_num_threads(max(1, min(4, os.cpu_count() or 1)))
+    if a.work is not None and Path(a.work).exists() and any(Path(a.work).iterdir()):
+        p.error(f"--work {a.work}: the folder is not empty; give a new or empty one (checkpoints and frames are written there)")
     work_ctx = tempfile.TemporaryDirectory(prefix="react3d-bench-models-") if a.work is None else None
     work = Path(a.work or work_ctx.name)  # type: ignore[union-attr]
     result: dict[str, Any] = {"device": torch.cuda.get_device_name(0) if gpu else "cpu", "torch": torch.__version__,

@@ -6,10 +6,11 @@ set -o pipefail
 OUT_DIR=${1:-benchmarks/results/gpu}
 mkdir -p "$OUT_DIR"
 if ls .whl/*.whl >/dev/null 2>&1; then
-  python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --upgrade --target /tmp/site .whl/*.whl || exit 1
-  export PYTHONPATH=/tmp/site:$PWD
+  SITE=$(mktemp -d /tmp/react3d-gpu-site.XXXXXX)  # our own folder: nothing of the machine's is touched
+  python3 -m pip install -q --no-index --no-deps --no-compile --no-cache-dir --target "$SITE" .whl/*.whl || exit 1
+  export PYTHONPATH=$SITE:$PWD
   if ! python3 -c "import transformers" 2>"$OUT_DIR/carried_transformers.err"; then  # keep the machine's own
-    rm -rf /tmp/site/transformers /tmp/site/transformers-*.dist-info
+    rm -rf "$SITE"/transformers "$SITE"/transformers-*.dist-info
   fi
 fi
 export PYTHONUNBUFFERED=1 HF_HUB_OFFLINE=1
@@ -17,4 +18,4 @@ nvidia-smi --query-gpu=name,memory.total,driver_version --format=csv | tee "$OUT
 python3 -c "import torch, transformers, sys; print(sys.version.split()[0], torch.__version__, transformers.__version__, torch.cuda.get_device_name(0))" | tee -a "$OUT_DIR/nvidia_smi.txt"
 timeout 120 python3 -m pytest -q -p no:cacheprovider -m gpu tests/perception/models/test_models_gpu.py 2>&1 | tee "$OUT_DIR/gpu_tests.log"
 timeout 120 python3 benchmarks/bench_models.py --images 16 --rebuild-calls 1 --json "$OUT_DIR/bench_models.json" 2>&1 | tee "$OUT_DIR/bench_models.log"
-timeout 300 python3 benchmarks/bench_models_scene.py --json "$OUT_DIR/bench_models_scene.json" --work /tmp/bench_scene 2>&1 | tee "$OUT_DIR/bench_models_scene.log"
+timeout 300 python3 benchmarks/bench_models_scene.py --json "$OUT_DIR/bench_models_scene.json" 2>&1 | tee "$OUT_DIR/bench_models_scene.log"

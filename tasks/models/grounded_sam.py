@@ -168,11 +168,8 @@ def to_sam_input(coords: np.ndarray, original_size: Sequence[int], reshaped_size
 
 def sam_box_masks(sam: Loaded, emb: torch.Tensor, inputs: dict, i: int, boxes: np.ndarray) -> np.ndarray:
     """Masks (N,H,W) of frame ``i`` of an embedded batch for its N boxes (original pixel coordinates)."""
-    orig, resh = inputs["original_sizes"][i].tolist(), inputs["reshaped_input_sizes"][i].tolist()
-    box_t = torch.as_tensor(to_sam_input(boxes, orig, resh)[None], device=sam.device, dtype=sam.dtype)
-    with torch.inference_mode():
-        out = sam.model(image_embeddings=emb[i : i + 1], input_boxes=box_t, multimask_output=False)
-    return masks_to_original(sam, out.pred_masks, orig, resh)
+    one = {k: inputs[k][i : i + 1] for k in ("original_sizes", "reshaped_input_sizes")}
+    return sam_box_masks_batched(sam, emb[i : i + 1], one, [boxes])[0]
 
 
 def sam_box_masks_batched(sam: Loaded, emb: torch.Tensor, inputs: dict, boxes: Sequence[np.ndarray]) -> list[np.ndarray]:

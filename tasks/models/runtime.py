@@ -10,6 +10,7 @@ from __future__ import annotations
 import logging
 import os
 import threading
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -115,12 +116,12 @@ def pretrained(cls: Any, model_id: str, device: torch.device, dtype: torch.dtype
 # processors (no torchvision installed) and CPU runs keep the CPU path; a processor that refuses the
 # keyword is remembered and not asked again.
 
-_NO_DEVICE_KWARG: set[int] = set()
+_NO_DEVICE_KWARG: weakref.WeakSet[Any] = weakref.WeakSet()  # processors that refused it (not their ids: ids are reused)
 
 
 def _accepts_device(processor: Any) -> bool:
     ip = getattr(processor, "image_processor", processor)
-    return not type(ip).__name__.endswith("Pil") and id(processor) not in _NO_DEVICE_KWARG
+    return not type(ip).__name__.endswith("Pil") and processor not in _NO_DEVICE_KWARG
 
 
 def preprocess(processor: Any, device: torch.device, on_device: bool = True, **kwargs: Any) -> dict[str, Any]:
@@ -131,7 +132,7 @@ def preprocess(processor: Any, device: torch.device, on_device: bool = True, **k
             return dict(processor(**kwargs, return_tensors="pt", device=str(device)))
         except Exception as exc:  # noqa: BLE001 - no device keyword in this version; a real input error recurs below
             log.info("%s does not pre-process on %s (%s); using the CPU", type(processor).__name__, device, exc)
-            _NO_DEVICE_KWARG.add(id(processor))
+            _NO_DEVICE_KWARG.add(processor)
     return dict(processor(**kwargs, return_tensors="pt"))
 
 
