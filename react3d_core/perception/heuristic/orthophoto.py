@@ -85,9 +85,33 @@ class ColourCalibration:
 
 @dataclass
 class _View:
+    """What one view sees of a plane's grid, cropped to the rows/columns it sees (a view sees only a
+    part of a large plane; sampling the rest would be wasted work)."""
+
     frame: int
-    xn: np.ndarray   # normalised image coords (x/z, y/z) of the grid, float32 (H, W, 2)
-    ok: np.ndarray   # grid pixels this view sees
+    xn: np.ndarray   # normalised image coords (x/z, y/z) of the crop, float32 (h, w, 2)
+    ok: np.ndarray   # crop pixels this view sees
+    r0: int = 0      # the crop's first row / column in the grid
+    c0: int = 0
+
+    @staticmethod
+    def cropped(frame: int, xn: np.ndarray, ok: np.ndarray, r_off: int = 0, c_off: int = 0) -> "_View":
+        """The view cut to the bounding box of ``ok``; (``r_off``, ``c_off``): where ``xn``/``ok`` start in the grid."""
+        rows, cols = np.flatnonzero(ok.any(1)), np.flatnonzero(ok.any(0))
+        r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+        return _View(frame, np.ascontiguousarray(xn[r0:r1, c0:c1]), np.ascontiguousarray(ok[r0:r1, c0:c1]),
+                     int(r0) + r_off, int(c0) + c_off)
+
+    def every_other(self) -> "_View":
+        """The view on the grid's every other row and column (grid pixels with even indices)."""
+        lr, lc = self.r0 % 2, self.c0 % 2
+        return _View(self.frame, self.xn[lr::2, lc::2], self.ok[lr::2, lc::2], (self.r0 + lr) // 2, (self.c0 + lc) // 2)
+
+    def paste(self, crop: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+        """``crop`` (h, w[, C]) placed in a NaN grid of ``shape``."""
+        out = np.full(tuple(shape) + crop.shape[2:], np.nan, np.float32)
+        out[self.r0:self.r0 + crop.shape[0], self.c0:self.c0 + crop.shape[1]] = crop
+        return out
 
 
 def _grid(plane: Plane, res: float, margin: float) -> tuple[np.ndarray, float, float]:
@@ -123,7 +147,11 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         w2c = f.w2c.astype(np.float32)
         K = intr.K
         for i in which:
-            pc = grids[i][0] @ w2c[:3, :3].T + w2c[:3, 3]
+            window = _window_in_view(grids[i][0], w2c, K, intr.width, intr.height)
+            if window is None:
+                continue
+            r0, r1, c0, c1 = window
+            pc = grids[i][0][r0:r1, c0:c1] @ w2c[:3, :3].T + w2c[:3, 3]
             z = pc[..., 2]
             with np.errstate(divide="ignore", invalid="ignore"):
                 xn = np.stack([pc[..., 0] / z, pc[..., 1] / z], -1).astype(np.float32)
@@ -134,14 +162,14 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             # the view sees the plane point when the scan surface there is at the plane's depth
             ok = inside & usable[ry, rx] & (np.abs(depth[ry, rx] - z) < params.depth_tol + 0.01 * np.abs(z))
             if ok.sum() >= 50:
-                views[i].append(_View(fi, xn, ok))
+                views[i].append(_View.cropped(fi, xn, ok, r0, c0))
         if any(v and v[-1].frame == fi for v in views):
             images[fi] = read_rgb(f)
     calib = _calibrate(views, frames, images, params) if params.calibrate else ColourCalibration()
     out = []
     for i, p in enumerate(planes):
         pts, u0, v_top, res = grids[i]
-        stack = [_sample(images[v.frame], frames[v.frame], v, calib) for v in views[i]]
+        stack = [v.paste(_sample(images[v.frame], frames[v.frame], v, calib), pts.shape[:2]) for v in views[i]]
         if stack:
             st = np.stack(stack)
             n = np.isfinite(st[..., 0]).sum(0)
@@ -154,35 +182,103 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
     return out, calib
 
 
+def _window_in_view(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int, height: int,
+                    step: int = 4) -> tuple[int, int, int, int] | None:
+    """Rows r0:r1, columns c0:c1 of the grid ``pts`` (H, W, 3) that can fall inside the image: found on
+    every ``step``-th grid point, widened by a step (the plane's visible part is convex, so no run of
+    grid points inside the image is missed unless it is thinner than a step). None: none inside."""
+    sub = pts[::step, ::step]
+    pc = sub @ w2c[:3, :3].T + w2c[:3, 3]
+    z = pc[..., 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = K[0, 0] * pc[..., 0] / z + K[0, 2]
+        y = K[1, 1] * pc[..., 1] / z + K[1, 2]
+    inside = (z > 0.1) & (x >= 0) & (x <= width - 1) & (y >= 0) & (y <= height - 1)
+    if not inside.any():
+        return None
+    rows, cols = np.flatnonzero(inside.any(1)), np.flatnonzero(inside.any(0))
+    H, W = pts.shape[:2]
+    return (max(0, (rows[0] - 1) * step), min(H, (rows[-1] + 1) * step + 1),
+            max(0, (cols[0] - 1) * step), min(W, (cols[-1] + 1) * step + 1))
+
+
 def _sample(img: np.ndarray, f: Frame, v: _View, c: ColourCalibration, gray: bool = False) -> np.ndarray:
-    """The view's colours on the grid (NaN where unseen), exposure-normalised, under calibration ``c``."""
+    """The view's colours on its crop of the grid (NaN where unseen), exposure-normalised, under
+    calibration ``c``. Only the image window the samples fall in is converted and read."""
     H, W = img.shape[:2]
     intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
     s = W / 640.0
     x = (c.scale * intr.fx * v.xn[..., 0] + intr.cx + c.dx * s).astype(np.float32)
     y = (c.scale * intr.fy * v.xn[..., 1] + intr.cy + c.dy * s).astype(np.float32)
-    src = (img if img.ndim == 2 else cv2.cvtColor(img, cv2.COLOR_RGB2GRAY)) if gray else img
-    col = cv2.remap(src.astype(np.float32), np.where(v.ok, x, -1), np.where(v.ok, y, -1), cv2.INTER_LINEAR,
-                    borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     inside = v.ok & (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
-    if gray:
-        col = col[..., None]
+    nch = 1 if gray or img.ndim == 2 else img.shape[2]
     if inside.sum() < 20:
-        return np.full(col.shape, np.nan, np.float32)
+        return np.full(v.ok.shape + (nch,), np.nan, np.float32)
+    xi, yi = x[inside], y[inside]
+    x0, y0 = int(np.floor(xi.min())), int(np.floor(yi.min()))
+    x1, y1 = min(W, int(np.floor(xi.max())) + 2), min(H, int(np.floor(yi.max())) + 2)
+    win = img[y0:y1, x0:x1]
+    if gray and win.ndim == 3:
+        win = cv2.cvtColor(win, cv2.COLOR_RGB2GRAY)
+    col = cv2.remap(win.astype(np.float32, copy=False), np.where(inside, x - x0, -1), np.where(inside, y - y0, -1),
+                    cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    if col.ndim == 2:
+        col = col[..., None]
     col = col / max(float(col[inside].mean()), 1.0)
     col[~inside] = np.nan
     return col
 
 
-def _disagreement(views: list[_View], frames: Sequence[Frame], images: dict[int, np.ndarray], c: ColourCalibration) -> float:
-    """Mean per-pixel variance across views of the exposure-normalised brightness (pixels seen >= 3 times)."""
-    st = np.stack([_sample(images[v.frame], frames[v.frame], v, c, gray=True)[..., 0] for v in views])
-    n = np.isfinite(st).sum(0)
-    if (n >= 3).sum() < 100:
+@dataclass
+class _Points:
+    """One view's seen points of a calibration grid, flattened: grid index and normalised image coords."""
+
+    frame: int
+    idx: np.ndarray  # (N,) flat index into the calibration grid
+    xn: np.ndarray   # (N, 2) float32
+
+
+def _remap_points(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Bilinear samples of ``img`` at (x, y) with cv2.remap's own arithmetic (maps laid out in rows of
+    1024: remap's maps must stay under 32767 a side)."""
+    n = len(x)
+    m = -(-n // 1024) * 1024
+    mx, my = np.full(m, -1, np.float32), np.full(m, -1, np.float32)
+    mx[:n], my[:n] = x, y
+    out = cv2.remap(img, mx.reshape(-1, 1024), my.reshape(-1, 1024), cv2.INTER_LINEAR,
+                    borderMode=cv2.BORDER_CONSTANT, borderValue=0)
+    return out.reshape(-1)[:n]
+
+
+def _disagreement(views: list[_Points], frames: Sequence[Frame], gray: dict[int, np.ndarray], c: ColourCalibration,
+                  n_grid: int) -> float:
+    """Mean per-pixel variance across views of the exposure-normalised brightness (pixels seen >= 3
+    times), accumulated with bincount over the seen points only."""
+    idx, val = [], []
+    for v in views:
+        img = gray[v.frame]
+        H, W = img.shape[:2]
+        f = frames[v.frame]
+        intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
+        s = W / 640.0
+        x = (c.scale * intr.fx * v.xn[:, 0] + intr.cx + c.dx * s).astype(np.float32)
+        y = (c.scale * intr.fy * v.xn[:, 1] + intr.cy + c.dy * s).astype(np.float32)
+        inside = (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
+        if inside.sum() < 20:
+            continue
+        col = _remap_points(img, x[inside], y[inside])
+        idx.append(v.idx[inside])
+        val.append(col / max(float(col.mean()), 1.0))
+    if not idx:
         return float("nan")
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return float(np.nanmean(np.nanvar(st, 0)[n >= 3]))
+    i, x = np.concatenate(idx), np.concatenate(val).astype(np.float64)
+    n = np.bincount(i, minlength=n_grid)
+    many = n >= 3
+    if many.sum() < 100:
+        return float("nan")
+    s1, s2 = np.bincount(i, x, n_grid)[many], np.bincount(i, x * x, n_grid)[many]
+    mean = s1 / n[many]
+    return float(np.mean(np.maximum(s2 / n[many] - mean * mean, 0.0)))
 
 
 def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[int, np.ndarray],
@@ -190,33 +286,41 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
     """Coordinate search of focal scale, then shift, then scale again, on the two planes seen most
     (<= 12 views each, every other grid pixel)."""
     seen = [sum(int(v.ok.sum()) for v in vs) for vs in views]
-    use = []
+    use: list[tuple[list[_Points], int]] = []
     for i in np.argsort(seen)[::-1][:2]:
         vs = sorted(views[i], key=lambda v: -int(v.ok.sum()))[:12]
         if len(vs) >= 3:
-            use.append([_View(v.frame, v.xn[::2, ::2], v.ok[::2, ::2]) for v in vs])
+            sub = [v.every_other() for v in vs]
+            width = max(v.c0 + v.ok.shape[1] for v in sub)
+            pts = []
+            for v in sub:
+                rr, cc = np.nonzero(v.ok)
+                pts.append(_Points(v.frame, (rr + v.r0) * width + cc + v.c0, v.xn[rr, cc]))
+            use.append((pts, max(v.r0 + v.ok.shape[0] for v in sub) * width))
     if not use:
         return ColourCalibration()
-    gray = {v.frame: cv2.cvtColor(images[v.frame], cv2.COLOR_RGB2GRAY) for vs in use for v in vs}
-    images = gray  # every cost evaluation samples brightness only: convert each frame once
+    gray = {v.frame: cv2.cvtColor(images[v.frame], cv2.COLOR_RGB2GRAY).astype(np.float32) for vs, _ in use for v in vs}
 
     def cost(c: ColourCalibration) -> float:
-        vals = [_disagreement(vs, frames, images, c) for vs in use]
+        vals = [_disagreement(vs, frames, gray, c, n_grid) for vs, n_grid in use]
         vals = [v for v in vals if np.isfinite(v)]
         return float(np.mean(vals)) if vals else float("inf")
 
     base = cost(ColourCalibration())
     best, best_cost = ColourCalibration(), base
     lo, hi = p.scale_range
-    for step in ("scale", "shift", "scale", "shift"):
+    r = p.shift_range_px
+    # a coarse pass over the whole ranges, then a local one around the best (also when the best is
+    # still the identity: re-running the coarse grids there only repeats evaluations)
+    for step, coarse in (("scale", True), ("shift", True), ("scale", False), ("shift", False)):
         if step == "scale":
-            cands = [ColourCalibration(s, best.dx, best.dy) for s in np.linspace(lo, hi, 15)] if best.scale == 1.0 else \
+            cands = [ColourCalibration(s, best.dx, best.dy) for s in np.linspace(lo, hi, 15)] if coarse else \
                 [ColourCalibration(best.scale + d, best.dx, best.dy) for d in (-0.02, -0.01, 0.01, 0.02)]
         else:
-            r = p.shift_range_px
             cands = [ColourCalibration(best.scale, best.dx + dx, best.dy + dy)
-                     for dx in np.linspace(-r, r, 5) for dy in np.linspace(-r, r, 5)] if step == "shift" and best.dx == 0 and best.dy == 0 else \
-                [ColourCalibration(best.scale, best.dx + dx, best.dy + dy) for dx in (-3, 0, 3) for dy in (-3, 0, 3)]
+                     for dx in np.linspace(-r, r, 5) for dy in np.linspace(-r, r, 5)] if coarse else \
+                [ColourCalibration(best.scale, best.dx + dx, best.dy + dy) for dx in (-3, 0, 3) for dy in (-3, 0, 3)
+                 if dx or dy]
         for c in cands:
             v = cost(c)
             if v < best_cost:
