@@ -116,6 +116,7 @@ class HeuristicConfig(StageConfig):
     handle_background_win: float = Field(0.12, gt=0, description="Image handles: window of the local background (m).")
     cell_min_seen: float = Field(0.55, ge=0, le=1, description="Image cells: share of a cell the plane's faces must cover.")
     max_clutter: float = Field(0.18, ge=0, le=1, description="Image cells: share of a cell's pixels off its local background above which it is clutter (posters, tiles, shelves).")
+    max_clutter_handle: float = Field(0.3, ge=0, le=1, description="Image cells: the same share for a cell holding a handle (raised-panel doors shade their own faces; a handle is evidence of a front); never below max_clutter.")
     handle_outline_margin: float = Field(0.02, ge=0, description="Image handles: colour blobs this close to the plane's outline are not handles (m).")
     handle_shadows: bool = Field(True, description="Image handles: on a front without a seen handle, an enclosed horizontal unseen hole of handle size above the cameras' median height is the handle's scanning shadow (a bar seen from below hides the front behind it in every view); it types the joint (wall-cabinet flaps), it does not cut cells.")
     texture_factor: float = Field(3.0, ge=0, description="Image path: handle/seam thresholds rise to this many times the plane's median response (textured planes).")

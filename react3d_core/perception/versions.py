@@ -4,7 +4,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 2: frame-and-panel fronts, rims, drawer_max_h 0.45; 3: fronts from the colour frames; 4: sliding doors;
 # 5: straight seams by line median, handle shadows filled, texture-adaptive clutter; 6: splash-back rule,
 # colour steps beat weaker dark lines, line structure and the cell's own colour in the clutter test;
-# 7: enclosed handle-shaped unseen holes are handles (wall-cabinet flaps), mirrored background border
-HEURISTIC_VERSION = "7"
+# 7: enclosed handle-shaped unseen holes are handles (wall-cabinet flaps), mirrored background border;
+# 8: a cell holding a handle may be more cluttered (max_clutter_handle 0.3: raised-panel doors)
+HEURISTIC_VERSION = "8"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -41,6 +41,7 @@ class CellParams:
     background_win: float = _H.handle_background_win  # m: window of the local background for handles
     min_seen: float = _H.cell_min_seen           # a cell's mesh coverage fraction
     max_clutter: float = _H.max_clutter          # fraction of a cell's pixels off its local background (posters, tiles, shelves)
+    max_clutter_handle: float = _H.max_clutter_handle  # the same for a cell holding a handle
     outline_margin: float = _H.handle_outline_margin  # m: colour blobs this close to the plane's outline are not handles
     texture_factor: float = _H.texture_factor    # handle/seam thresholds rise to this many times the plane's median response
     seam_z: float = _H.seam_z                    # a straight seam: the line's median brightness dips this many noise units below its neighbours

@@ -65,7 +65,7 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
                          handle_contrast=cfg.handle_contrast, handle_len=tuple(cfg.handle_len),
                          handle_thick=tuple(cfg.handle_thick), handle_aspect=cfg.handle_aspect,
                          background_win=cfg.handle_background_win, min_seen=cfg.cell_min_seen,
-                         max_clutter=cfg.max_clutter, outline_margin=cfg.handle_outline_margin,
+                         max_clutter=cfg.max_clutter, max_clutter_handle=cfg.max_clutter_handle, outline_margin=cfg.handle_outline_margin,
                          texture_factor=cfg.texture_factor, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
                          step_z=cfg.step_z, max_depth=cfg.max_split_depth, step_over_dip=cfg.step_over_dip),
         plane_offset_tol=cfg.plane_offset_tol, plane_angle_tol_deg=cfg.plane_angle_tol_deg,
@@ -334,7 +334,8 @@ def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray,
     if sub.size == 0 or sub.mean() < params.cells.min_seen:
         return None
     seen = o.n_views[cell.r0:cell.r1, cell.c0:cell.c1] > 0
-    if seen.any() and _clutter_share(o, cell, clutter, seen, plain) > params.cells.max_clutter:
+    limit = max(params.cells.max_clutter, params.cells.max_clutter_handle) if cell.handles else params.cells.max_clutter
+    if seen.any() and _clutter_share(o, cell, clutter, seen, plain) > limit:
         return None  # posters, tiles, shelves: a front is a plain panel
     rows, cols = np.nonzero(sub)
     c0, c1 = cell.c0 + cols.min(), cell.c0 + cols.max() + 1   # tighten to the covered area

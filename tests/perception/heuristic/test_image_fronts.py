@@ -411,3 +411,34 @@ def test_shadow_in_cell_picks_the_largest_shadow_centred_in_it() -> None:
     assert pts.shape == (6 * 30, 3)
     assert np.allclose(pts[0], [10.5 * 0.005, 0.0, 0.2 - 20.5 * 0.005])
     assert _shadow_in_cell(o, Cell(0, 0, 50, 40), []) is None
+
+
+def test_a_cell_with_a_handle_may_be_more_cluttered() -> None:
+    """A 0.5 x 0.7 m cell (1 cm px), 25 % of it off its background (a raised panel's shading): over
+    max_clutter 0.18, under max_clutter_handle 0.3. Holding a handle it is a front; without one (cut on
+    all four sides, so the handle is the only difference) it is clutter; at 35 % it is clutter either way."""
+    from react3d_core.perception.heuristic.front_cells import Cell, Handle
+    from react3d_core.perception.heuristic.fronts import FrontRules
+    from react3d_core.perception.heuristic.image_fronts import ImageFrontParams, _cell_front
+
+    h, w = 70, 50
+    o = _ortho(np.ones((h, w, 3), np.float32), 0.01)
+    cov = np.ones((h, w), bool)
+    clutter = np.zeros((h, w), bool)
+    clutter[:, : int(0.25 * w) + 1] = True                  # 13 of 50 columns: 0.26
+    # faces of the plane (y = 0): centroids on a 2 cm lattice over the cell, as (u, z, depth)
+    uu, zz = np.meshgrid(np.arange(0.01, 0.5, 0.02), np.arange(0.01, 0.7, 0.02))
+    in_plane = np.stack([uu.ravel(), zz.ravel(), np.zeros(uu.size)], 1)
+    pix = np.stack(np.meshgrid(np.arange(40, 43), np.arange(20, 40)), -1).reshape(-1, 2)
+    handle = Handle((40, 20, 43, 40), False, pix)
+    params = ImageFrontParams()
+    assert params.cells.max_clutter < 0.26 < params.cells.max_clutter_handle
+    with_handle = Cell(0, 0, w, h, handles=[handle], cut_sides=4)
+    without = Cell(0, 0, w, h, handles=[], cut_sides=4)
+    rules = FrontRules()
+    assert _cell_front(o, without, cov, np.zeros((h, w), bool), in_plane, rules, params, None) is not None
+    f = _cell_front(o, with_handle, cov, clutter, in_plane, rules, params, None)
+    assert f is not None and f.handle_points is not None and abs(f.w - 0.5) < 0.02 and abs(f.h - 0.7) < 0.02
+    assert _cell_front(o, without, cov, clutter, in_plane, rules, params, None) is None
+    clutter[:, : int(0.35 * w)] = True                      # 0.34: over both limits
+    assert _cell_front(o, with_handle, cov, clutter, in_plane, rules, params, None) is None
