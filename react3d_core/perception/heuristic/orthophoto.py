@@ -15,7 +15,6 @@ largest planes. A scan whose colour is registered keeps scale 1, shift 0.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
@@ -151,12 +150,7 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             if window is None:
                 continue
             r0, r1, c0, c1 = window
-            pc = grids[i][0][r0:r1, c0:c1] @ w2c[:3, :3].T + w2c[:3, 3]
-            z = pc[..., 2]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                xn = np.stack([pc[..., 0] / z, pc[..., 1] / z], -1).astype(np.float32)
-            x, y = K[0, 0] * xn[..., 0] + K[0, 2], K[1, 1] * xn[..., 1] + K[1, 2]
-            inside = (z > 0.1) & (x >= 0) & (x <= intr.width - 1) & (y >= 0) & (y <= intr.height - 1)
+            xn, x, y, z, inside = _project(grids[i][0][r0:r1, c0:c1], w2c, K, intr.width, intr.height)
             rx = np.clip(np.round((np.where(inside, x, 0) + 0.5) * params.render_scale - 0.5), 0, rw - 1).astype(np.int32)
             ry = np.clip(np.round((np.where(inside, y, 0) + 0.5) * params.render_scale - 0.5), 0, rh - 1).astype(np.int32)
             # the view sees the plane point when the scan surface there is at the plane's depth
@@ -182,18 +176,25 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
     return out, calib
 
 
+def _project(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int, height: int
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """World points (..., 3) into a view: normalised coords (..., 2) float32, pixel x, y, depth z, and
+    whether each lands inside the image in front of the camera."""
+    pc = pts @ w2c[:3, :3].T + w2c[:3, 3]
+    z = pc[..., 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xn = np.stack([pc[..., 0] / z, pc[..., 1] / z], -1).astype(np.float32)
+    x, y = K[0, 0] * xn[..., 0] + K[0, 2], K[1, 1] * xn[..., 1] + K[1, 2]
+    inside = (z > 0.1) & (x >= 0) & (x <= width - 1) & (y >= 0) & (y <= height - 1)
+    return xn, x, y, z, inside
+
+
 def _window_in_view(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int, height: int,
                     step: int = 4) -> tuple[int, int, int, int] | None:
     """Rows r0:r1, columns c0:c1 of the grid ``pts`` (H, W, 3) that can fall inside the image: found on
     every ``step``-th grid point, widened by a step (the plane's visible part is convex, so no run of
     grid points inside the image is missed unless it is thinner than a step). None: none inside."""
-    sub = pts[::step, ::step]
-    pc = sub @ w2c[:3, :3].T + w2c[:3, 3]
-    z = pc[..., 2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        x = K[0, 0] * pc[..., 0] / z + K[0, 2]
-        y = K[1, 1] * pc[..., 1] / z + K[1, 2]
-    inside = (z > 0.1) & (x >= 0) & (x <= width - 1) & (y >= 0) & (y <= height - 1)
+    inside = _project(pts[::step, ::step], w2c, K, width, height)[4]
     if not inside.any():
         return None
     rows, cols = np.flatnonzero(inside.any(1)), np.flatnonzero(inside.any(0))
@@ -202,14 +203,21 @@ def _window_in_view(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int,
             max(0, (cols[0] - 1) * step), min(W, (cols[-1] + 1) * step + 1))
 
 
+def _pixel_coords(xn: np.ndarray, f: Frame, W: int, H: int, c: ColourCalibration) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel coords in ``f``'s colour image of size W x H of normalised coords ``xn`` (..., 2), under
+    calibration ``c`` (its shift is in px at 640 px width)."""
+    intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
+    s = W / 640.0
+    x = (c.scale * intr.fx * xn[..., 0] + intr.cx + c.dx * s).astype(np.float32)
+    y = (c.scale * intr.fy * xn[..., 1] + intr.cy + c.dy * s).astype(np.float32)
+    return x, y
+
+
 def _sample(img: np.ndarray, f: Frame, v: _View, c: ColourCalibration, gray: bool = False) -> np.ndarray:
     """The view's colours on its crop of the grid (NaN where unseen), exposure-normalised, under
     calibration ``c``. Only the image window the samples fall in is converted and read."""
     H, W = img.shape[:2]
-    intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
-    s = W / 640.0
-    x = (c.scale * intr.fx * v.xn[..., 0] + intr.cx + c.dx * s).astype(np.float32)
-    y = (c.scale * intr.fy * v.xn[..., 1] + intr.cy + c.dy * s).astype(np.float32)
+    x, y = _pixel_coords(v.xn, f, W, H, c)
     inside = v.ok & (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
     nch = 1 if gray or img.ndim == 2 else img.shape[2]
     if inside.sum() < 20:
@@ -258,11 +266,7 @@ def _disagreement(views: list[_Points], frames: Sequence[Frame], gray: dict[int,
     for v in views:
         img = gray[v.frame]
         H, W = img.shape[:2]
-        f = frames[v.frame]
-        intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
-        s = W / 640.0
-        x = (c.scale * intr.fx * v.xn[:, 0] + intr.cx + c.dx * s).astype(np.float32)
-        y = (c.scale * intr.fy * v.xn[:, 1] + intr.cy + c.dy * s).astype(np.float32)
+        x, y = _pixel_coords(v.xn, frames[v.frame], W, H, c)
         inside = (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
         if inside.sum() < 20:
             continue

@@ -9,21 +9,10 @@ from pathlib import Path
 import cv2
 import numpy as np
 
+from react3d_core.camera import look_at
 from react3d_core.data.frames import Frame, ImageRef, Intrinsics
 from react3d_core.perception.heuristic.orthophoto import (ColourCalibration, _disagreement, _Points, _remap_points,
                                                           _View, _window_in_view)
-
-
-def _look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
-    z = target - eye
-    z = z / np.linalg.norm(z)
-    x = np.cross(z, [0.0, 0.0, 1.0])
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
-    c2w = np.eye(4)
-    c2w[:3, :3] = np.stack([x, y, z], 1)
-    c2w[:3, 3] = eye
-    return c2w
 
 
 def test_remap_points_matches_remap_on_a_grid_beyond_remaps_side_limit() -> None:
@@ -43,7 +32,7 @@ def test_window_holds_every_grid_point_inside_the_image() -> None:
     pts = np.stack([u, np.zeros_like(u), v], -1).astype(np.float32)
     K = np.array([[300.0, 0, 160], [0, 300.0, 120], [0, 0, 1]])
     for eye, target in (([0.3, -1.2, 1.0], [0.5, 0.0, 0.9]), ([-1.0, -0.8, 1.4], [-1.6, 0.0, 0.5])):
-        w2c = np.linalg.inv(_look_at(np.array(eye), np.array(target))).astype(np.float32)
+        w2c = np.linalg.inv(look_at(np.array(eye), np.array(target))).astype(np.float32)
         pc = pts @ w2c[:3, :3].T + w2c[:3, 3]
         x, y = K[0, 0] * pc[..., 0] / pc[..., 2] + K[0, 2], K[1, 1] * pc[..., 1] / pc[..., 2] + K[1, 2]
         inside = (pc[..., 2] > 0.1) & (x >= 0) & (x <= 319) & (y >= 0) & (y <= 239)
@@ -52,7 +41,7 @@ def test_window_holds_every_grid_point_inside_the_image() -> None:
         assert rows.min() >= r0 and rows.max() < r1 and cols.min() >= c0 and cols.max() < c1
         assert (r1 - r0) * (c1 - c0) < 0.6 * inside.size  # the window is a real saving here
         assert (r1 - r0) * (c1 - c0) < 1.3 * (np.ptp(rows) + 1) * (np.ptp(cols) + 1) + 4 * (r1 - r0 + c1 - c0)
-    w2c_away = np.linalg.inv(_look_at(np.array([0.0, -1.0, 1.0]), np.array([0.0, -3.0, 1.0]))).astype(np.float32)
+    w2c_away = np.linalg.inv(look_at(np.array([0.0, -1.0, 1.0]), np.array([0.0, -3.0, 1.0]))).astype(np.float32)
     assert _window_in_view(pts, w2c_away, K, 320, 240) is None  # looking away from the wall
 
 
