@@ -15,8 +15,9 @@ is downloaded. The tag filter is an OpenAI-style chat endpoint faked on 127.0.0.
     one worker; pre-processing on the CPU; SAM with eager attention;
   * per model call: ms per frame, sequential, batch --batch: image read, CLIP, Grounding DINO, SAM
     encoder, SAM decoder with its masks;
-  * reference-style: per frame, Grounding DINO and SAM loaded anew in fp32 and called with batch 1 as
-    per-frame scripts do (--ref-frames frames), and the same calls with the models kept (forward only);
+  * reference-style: per frame, Grounding DINO and SAM loaded anew in fp32 with stock from_pretrained and
+    called with batch 1 as per-frame scripts do, Grounding DINO post-processed on its output tensors as in
+    its model card (--ref-frames frames), and the same calls with the models kept (forward only);
   * out-of-memory: the segmenter asked for --subset frames in one batch under a memory cap that fits
     about --batch of them; split_on_oom must halve the batch until it fits and return every frame.
 
@@ -168,29 +169,62 @@ def per_call(perception: Any, frames: list[Any], batch: int, reps: int) -> dict[
     return out
 
 
+def stock_models(paths: dict[str, Path], device: Any) -> tuple[Any, Any]:
+    """Grounding DINO and SAM as a per-frame script loads them: fp32, stock ``from_pretrained``, none of
+    the backend's changes (no cached SAM position tables)."""
+    import torch
+    from transformers import AutoProcessor, GroundingDinoForObjectDetection, SamModel, SamProcessor
+
+    from tasks.models.runtime import Loaded
+
+    det = GroundingDinoForObjectDetection.from_pretrained(str(paths["detector"])).to(device).eval()
+    sam = SamModel.from_pretrained(str(paths["sam"])).to(device).eval()
+    return (Loaded(det, AutoProcessor.from_pretrained(str(paths["detector"])), device, torch.float32),
+            Loaded(sam, SamProcessor.from_pretrained(str(paths["sam"])), device, torch.float32))
+
+
+def stock_detect(det: Any, image: Any, box_t: float, text_t: float) -> Any:
+    """One frame through Grounding DINO as its model card does: processor, forward, post-processing on the
+    model's output tensors (on the GPU when the model is there)."""
+    import torch
+
+    from tasks.models.grounded_sam import detections_from_outputs, detector_prompt
+
+    inputs = det.processor(images=[image], text=[detector_prompt(PHRASES)], return_tensors="pt").to(det.device)
+    with torch.inference_mode():
+        out = det.model(**inputs)
+    return detections_from_outputs(det.processor, out, inputs["input_ids"], [image.shape[:2]], PHRASES, box_t, text_t)[0]
+
+
 def reference(paths: dict[str, Path], frames: list[Any], n: int, device: Any, box_t: float, text_t: float,
               max_det: int, rebuild: bool) -> float:
-    """Seconds per frame of the reference-style call: fp32, batch 1, (re)loaded per frame when ``rebuild``."""
+    """Seconds per frame of the reference-style call: stock models in fp32, batch 1, (re)loaded per frame
+    when ``rebuild``; transformers' input checks on, as they are by default."""
     import torch
 
     from react3d_core.scene_io.images import frame_rgb
-    from tasks.models.grounded_sam import detect, sam_box_masks, sam_image_embeddings, top_detections
-    from tasks.models.loaders import load_detector, load_sam
+    from tasks.models.grounded_sam import sam_box_masks, sam_image_embeddings, top_detections
 
-    models = None if rebuild else (load_detector(str(paths["detector"]), device, torch.float32),
-                                   load_sam(str(paths["sam"]), device, torch.float32))
+    saved = os.environ.get("TRANSFORMERS_DISABLE_TORCH_CHECK")
+    os.environ["TRANSFORMERS_DISABLE_TORCH_CHECK"] = "0"
+    models = None if rebuild else stock_models(paths, device)
 
     def one(f: Any) -> None:
-        det, sam = models or (load_detector(str(paths["detector"]), device, torch.float32),
-                              load_sam(str(paths["sam"]), device, torch.float32))
+        det, sam = models or stock_models(paths, device)
         image = frame_rgb(f)
-        d = top_detections(detect(det, [image], PHRASES, box_t, text_t, on_device=False)[0], 0.8, max_det)
+        d = top_detections(stock_detect(det, image, box_t, text_t), 0.8, max_det)
         emb, inputs = sam_image_embeddings(sam, [image], on_device=False)
         if len(d.boxes):
             sam_box_masks(sam, emb, inputs, 0, d.boxes)
 
-    one(frames[0])  # warm-up (CUDA context, kernels)
-    total = sum(timed(lambda f=f: one(f))[0] for f in frames[1 : n + 1])
+    try:
+        one(frames[0])  # warm-up (CUDA context, kernels)
+        total = sum(timed(lambda f=f: one(f))[0] for f in frames[1 : n + 1])
+    finally:
+        if saved is None:
+            os.environ.pop("TRANSFORMERS_DISABLE_TORCH_CHECK", None)
+        else:
+            os.environ["TRANSFORMERS_DISABLE_TORCH_CHECK"] = saved
     del models
     if torch.cuda.is_available():
         torch.cuda.empty_cache()

@@ -6,19 +6,23 @@ from typing import Any
 
 import torch
 
+from .host_sync import cache_sam_relative_positions, skip_shape_checks
 from .runtime import Loaded, hub_kwargs, pretrained
 
 
 def load_detector(model_id: str, device: torch.device, dtype: torch.dtype) -> Loaded:
-    """Grounding DINO (GroundingDinoForObjectDetection + its processor)."""
+    """Grounding DINO (GroundingDinoForObjectDetection + its processor); on a GPU without its input checks
+    that wait for the device (host_sync.skip_shape_checks)."""
     from transformers import AutoProcessor, GroundingDinoForObjectDetection
 
+    if device.type == "cuda":
+        skip_shape_checks()
     proc = AutoProcessor.from_pretrained(model_id, **hub_kwargs(model_id))
     return Loaded(pretrained(GroundingDinoForObjectDetection, model_id, device, dtype), proc, device, dtype)
 
 
 def load_sam(model_id: str, device: torch.device, dtype: torch.dtype) -> Loaded:
-    """SAM or SAM 2, chosen by the checkpoint's model_type."""
+    """SAM or SAM 2, chosen by the checkpoint's model_type; SAM's relative-position tables computed once per layer."""
     from transformers import AutoConfig
 
     model_type = AutoConfig.from_pretrained(model_id, **hub_kwargs(model_id)).model_type
@@ -26,7 +30,10 @@ def load_sam(model_id: str, device: torch.device, dtype: torch.dtype) -> Loaded:
         from transformers import Sam2Model as Model, Sam2Processor as Proc
     else:
         from transformers import SamModel as Model, SamProcessor as Proc
-    return Loaded(pretrained(Model, model_id, device, dtype), Proc.from_pretrained(model_id, **hub_kwargs(model_id)), device, dtype)
+    model = pretrained(Model, model_id, device, dtype)
+    if not model_type.startswith("sam2"):
+        cache_sam_relative_positions(model)
+    return Loaded(model, Proc.from_pretrained(model_id, **hub_kwargs(model_id)), device, dtype)
 
 
 def load_clip(model_id: str, device: torch.device, dtype: torch.dtype) -> Loaded:

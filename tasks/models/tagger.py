@@ -15,6 +15,7 @@ import torch
 
 from react3d_core.data.frames import Frame
 
+from .host_sync import worker_stream
 from .runtime import Loaded, preprocess, to_model
 
 
@@ -41,12 +42,18 @@ class ClipTagger:
             with torch.inference_mode():
                 t = self.clip.model.get_text_features(input_ids=tok["input_ids"].to(self.clip.device),
                                                       attention_mask=tok["attention_mask"].to(self.clip.device))
-            t = getattr(t, "pooler_output", t)
-            self._text = torch.nn.functional.normalize(t.float(), dim=-1)
+            t = torch.nn.functional.normalize(getattr(t, "pooler_output", t).float(), dim=-1)
+            if t.is_cuda:  # other threads read it from their own streams: complete before it is shared
+                torch.cuda.current_stream(t.device).synchronize()
+            self._text = t
         return self._text
 
     def probabilities(self, images: Sequence[np.ndarray]) -> np.ndarray:
         """(F,V) softmax over the vocabulary per image."""
+        with worker_stream(self.clip.device):
+            return self._probabilities(images)
+
+    def _probabilities(self, images: Sequence[np.ndarray]) -> np.ndarray:
         text = self._text_embeddings()
         rows = []
         for s in range(0, len(images), self.batch_size):

@@ -111,3 +111,21 @@ def test_tiny_bench_runs_on_the_gpu(tmp_path):
     assert r["device"] != "cpu" and r["runs"]["ours"]["frames"] == 12
     assert r["oom_split"]["returned_frames"] == 8
     assert np.isfinite(r["speedup_vs_ref_forward"])
+
+
+def test_threads_on_their_own_streams_give_the_sequential_masks(tiny_models, fake_server, make_frame, make_image):
+    """Four worker threads, each on its own CUDA stream (host_sync.worker_stream), against one thread."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    seg = make_model_perception(_cfg(tiny_models, fake_server)).segmenter
+    frames = [make_frame(f"f{i}", 120, 160) for i in range(8)]
+    images = [make_image(120, 160, i) for i in range(8)]
+    phrases = ["cabinet door", "door"]
+    ref = seg.segment(frames, images, phrases)
+    with ThreadPoolExecutor(4) as ex:
+        got = [m for part in ex.map(lambda s: seg.segment(frames[s : s + 2], images[s : s + 2], phrases), range(0, 8, 2))
+               for m in part]
+    assert [len(m) for m in got] == [len(m) for m in ref] and any(ref)
+    for a, b in zip(got, ref):
+        for x, y in zip(a, b):
+            assert x.box == pytest.approx(y.box) and (x.mask == y.mask).mean() > 0.999
