@@ -5,7 +5,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 5: straight seams by line median, handle shadows filled, texture-adaptive clutter; 6: splash-back rule,
 # colour steps beat weaker dark lines, line structure and the cell's own colour in the clutter test;
 # 7: enclosed handle-shaped unseen holes are handles (wall-cabinet flaps), mirrored background border;
-# 8: a cell holding a handle may be more cluttered (max_clutter_handle 0.3: raised-panel doors)
-HEURISTIC_VERSION = "8"
+# 8: a cell holding a handle may be more cluttered (max_clutter_handle 0.3: raised-panel doors);
+# 9: a handle-less image front reaching down to the floor is wall (plain_floor_gap)
+HEURISTIC_VERSION = "9"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -45,6 +45,8 @@ class ImageFrontParams:
     protrusion_depth: tuple[float, float] = _H.protrusion_depth  # m in front of the plane: mesh handles
     min_tile_side: float = _H.min_tile_side              # m: handle-less cells smaller than this both ways are tiles, not fronts
     handleless_min_seams: int = _H.handleless_min_seams  # a handle-less cell cut out by this many straight seams is a front (0: never)
+    plain_floor_gap: float = _H.plain_floor_gap          # m: a handle-less front reaching this close to the floor is wall (0: off)
+    floor_min_area: float = _H.floor_min_area            # m²: upward-facing area that makes a 2 cm band the floor
     cell_median_clutter: bool = _H.clutter_cell_median  # clutter also judged against the cell's own median colour
     line_min_len: float = _H.clutter_line_min_len        # m: straight lines this long (and thin) are a front's structure, not clutter
     line_max_width: float = _H.clutter_line_max_width    # m
@@ -72,7 +74,8 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
         min_plane_area=cfg.min_plane_area, plane_cell=cfg.plane_cell, plane_min_fragment_area=cfg.plane_min_fragment_area,
         face_depth=tuple(cfg.face_depth), outline_fill_px=cfg.outline_fill_px,
         protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
-        handleless_min_seams=cfg.handleless_min_seams, cell_median_clutter=cfg.clutter_cell_median,
+        handleless_min_seams=cfg.handleless_min_seams, plain_floor_gap=cfg.plain_floor_gap,
+        floor_min_area=cfg.floor_min_area, cell_median_clutter=cfg.clutter_cell_median,
         line_min_len=cfg.clutter_line_min_len, line_max_width=cfg.clutter_line_max_width, handle_shadows=cfg.handle_shadows)
 
 
@@ -86,6 +89,31 @@ class ImageFronts:
     planes: list[Plane]
     orthophotos: list[Orthophoto]
     calibration: ColourCalibration
+
+
+def floor_height(mesh: TriMesh, min_area: float, band: float = 0.02, min_up: float = 0.9) -> float | None:
+    """Height of the floor: the area-weighted median height of the lowest ``band``-high slice of
+    upward-facing faces holding ``min_area`` m²; None when no slice does (a scan without its floor)."""
+    up = mesh.face_normals[:, 2] > min_up
+    if not up.any() or min_area <= 0:
+        return None
+    z = mesh.face_centroids[up, 2]
+    bins = np.floor((z - z.min()) / band).astype(int)
+    area = np.bincount(bins, weights=mesh.face_areas[up])
+    full = np.flatnonzero(area >= min_area)
+    if not len(full):
+        return None
+    inb = bins == full[0]
+    order = np.argsort(z[inb])
+    cum = np.cumsum(mesh.face_areas[up][inb][order])
+    return float(z[inb][order][np.searchsorted(cum, 0.5 * cum[-1])])  # area-weighted median of the band
+
+
+def off_the_floor(fronts: list[Front], floor: float | None, gap: float) -> list[Front]:
+    """Fronts without a handle whose bottom edge is within ``gap`` of ``floor`` dropped (None: all kept)."""
+    if floor is None:
+        return list(fronts)
+    return [f for f in fronts if f.handle_points is not None or f.extent_v[0] > floor + gap]
 
 
 def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = _H.plane_min_fragment_area) -> np.ndarray:
@@ -232,6 +260,10 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     # have no handles and, tiled, cells smaller than a front
     fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded
               or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
+    # ... but a handle-less panel that reaches down to the floor is wall (beside a room door, say): base
+    # units stand on a plinth and room doors have handles
+    if params.plain_floor_gap > 0:
+        fronts = off_the_floor(fronts, floor_height(mesh, params.floor_min_area), params.plain_floor_gap)
     for f in fronts:
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else f.shadow_points
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)

@@ -442,3 +442,40 @@ def test_a_cell_with_a_handle_may_be_more_cluttered() -> None:
     assert _cell_front(o, without, cov, clutter, in_plane, rules, params, None) is None
     clutter[:, : int(0.35 * w)] = True                      # 0.34: over both limits
     assert _cell_front(o, with_handle, cov, clutter, in_plane, rules, params, None) is None
+
+
+def _quad(x0: float, x1: float, y0: float, y1: float, z: float) -> TriMesh:
+    v = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], float)
+    return TriMesh(v, np.array([[0, 1, 2], [0, 2, 3]]))
+
+
+def test_floor_height_hand_computed() -> None:
+    """Floor 2 x 2 m in two halves at z = -0.002 (1.5 m²) and +0.004 (2.5 m²), a worktop 1 m² at 0.9 m:
+    the lowest 2 cm band holds 4 m² >= 0.5, its area-weighted median is +0.004. Without the floor the
+    worktop alone (1 m²) is the floor at 0.5 m², and no floor at 2 m²."""
+    from react3d_core.perception.heuristic.image_fronts import floor_height
+
+    floor = _merge(_quad(0, 0.75, 0, 2, -0.002), _quad(0.75, 2, 0, 2, 0.004))
+    top = _quad(0, 1, 0, 1, 0.9)
+    assert floor_height(_merge(floor, top), 0.5) == pytest.approx(0.004)
+    assert floor_height(top, 0.5) == pytest.approx(0.9)
+    assert floor_height(top, 2.0) is None
+    down = TriMesh(top.vertices, top.faces[:, ::-1])  # facing down: a ceiling, not a floor
+    assert floor_height(down, 0.5) is None
+
+
+def test_handle_less_fronts_reaching_the_floor_are_wall() -> None:
+    """Beside a room door: plain panels from the floor (bottom 0.00 m) are dropped, a plain drawer on a
+    5 cm plinth and a handled door from the floor are kept; with no floor known nothing is dropped."""
+    from react3d_core.perception.heuristic.fronts import Front
+    from react3d_core.perception.heuristic.image_fronts import off_the_floor
+
+    def front(bottom: float, handle: bool) -> Front:
+        f = Front(facet=-1, handle_facets=[], center=np.zeros(3), n_out=np.array([0.0, -1, 0]), u=np.array([1.0, 0, 0]),
+                  extent_u=(0.0, 0.6), extent_v=(bottom, bottom + 0.5), faces=np.arange(4))
+        f.handle_points = np.zeros((3, 3)) if handle else None
+        return f
+
+    wall, drawer, door = front(0.0, False), front(0.05, False), front(0.0, True)
+    assert off_the_floor([wall, drawer, door], 0.001, 0.03) == [drawer, door]
+    assert off_the_floor([wall, drawer, door], None, 0.03) == [wall, drawer, door]
