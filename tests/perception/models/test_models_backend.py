@@ -118,6 +118,25 @@ def test_scene_benchmark_runs_tiny(tmp_path):
     assert set(r["per_call_ms_per_frame"]["batch2"]) >= {"grounding_dino", "sam_encoder", "sam_decoder_masks"}
 
 
+def test_stage_profiler_runs_tiny(tmp_path):
+    """benchmarks/profile_models_stage.py --quick on tiny models (CPU): the base run, the profiler tables
+    (ops and Python functions) and no device time without a device."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "profile_models_stage.py"
+    spec = importlib.util.spec_from_file_location("profile_models_stage", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert mod.main(["--tiny", "--quick", "--frames", "4", "--profile-frames", "4", "--width", "96", "--height", "72",
+                     "--batch", "2", "--workers", "2", "--out", str(tmp_path / "p")]) == 0
+    r = json.loads((tmp_path / "p" / "profile.json").read_text())
+    assert r["runs"]["base"]["frames"] == 4 and r["profile"]["profiled"]["workers"] == 1
+    assert r["profile"]["device_kernel_s"] == 0.0 and r["profile"]["self_cpu_s_all_threads"] > 0
+    tables = (tmp_path / "p" / "profile_tables.txt").read_text()
+    assert "## by self CPU time" in tables and "## Python (cProfile), one worker" in tables and "perceive" in tables
+
+
 def test_local_lm_tag_filter_path(tmp_path):
     """A tiny random Llama through the local-LM path: loads, generates, decodes; its gibberish is
     unreadable, so only 'door' survives (the documented fallback)."""
