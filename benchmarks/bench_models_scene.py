@@ -115,8 +115,40 @@ def timed(fn: Callable[[], Any]) -> tuple[float, Any]:
     return time.perf_counter() - t, out
 
 
+class GpuUtilisation:
+    """The device's own utilisation counter (percent of time a kernel ran, through NVML) sampled every
+    50 ms in a thread while the block runs; ``mean`` is None without a GPU or NVML."""
+
+    def __enter__(self) -> GpuUtilisation:
+        import torch
+
+        self.samples: list[float] = []
+        self._done = threading.Event()
+        self._thread = threading.Thread(target=self._sample, daemon=True)
+        if torch.cuda.is_available():
+            self._thread.start()
+        return self
+
+    def _sample(self) -> None:
+        import torch
+
+        while not self._done.wait(0.05):
+            try:
+                self.samples.append(float(torch.cuda.utilization()))
+            except Exception:  # noqa: BLE001 - no NVML here: no utilisation figure
+                return
+
+    def __exit__(self, *exc: object) -> None:
+        self._done.set()
+
+    @property
+    def mean(self) -> float | None:
+        return sum(self.samples) / len(self.samples) if self.samples else None
+
+
 def run_stage(perception: Any, frames: list[Any], cfg: Any, batch: int, workers: int) -> dict[str, Any]:
-    """The perception stage as the flow runs it: perceive() per batch in ``workers`` threads, masks packed."""
+    """The perception stage as the flow runs it: perceive() per batch in ``workers`` threads, masks packed
+    (one worker: in this thread, so a profiler started here records it)."""
     import torch
 
     from react3d_core.pipeline import perceive
@@ -131,11 +163,14 @@ def run_stage(perception: Any, frames: list[Any], cfg: Any, batch: int, workers:
         pack_masks([r["masks"]])  # what the perception task stores
         return sum(len(m) for m in r["masks"].values())
 
-    t, res = timed(lambda: list(ThreadPoolExecutor(workers).map(one, batches)) if workers > 1 else [one(b) for b in batches])
+    with GpuUtilisation() as util:
+        t, res = timed(lambda: list(ThreadPoolExecutor(workers).map(one, batches)) if workers > 1 else [one(b) for b in batches])
     row = {"frames": len(frames), "batch": batch, "workers": workers, "seconds": t, "frames_per_s": len(frames) / t,
            "masks": sum(res)}
     if torch.cuda.is_available():
         row["peak_gpu_gib"] = torch.cuda.max_memory_allocated() / 2**30
+    if util.mean is not None:
+        row["gpu_util_mean_pct"] = util.mean
     return row
 
 

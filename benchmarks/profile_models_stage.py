@@ -3,13 +3,12 @@
     python3 benchmarks/profile_models_stage.py --out DIR            # GPU: real architectures, random weights
     python3 benchmarks/profile_models_stage.py --tiny --frames 8 --out DIR   # CPU smoke run
 
-The stage as bench_models_scene.py runs it (perceive() per batch in worker threads, masks packed), then:
+The stage as bench_models_scene.py runs it (its run_stage: perceive() per batch in worker threads, masks
+packed, GPU utilisation read through NVML), then:
   * torch.profiler over --profile-frames frames: ops by self CPU time and by self device time, and the
     device's busy time against the wall time (is the stage bound by the GPU or by the host?);
   * cProfile of the same frames (one worker): the Python functions that hold the host;
-  * variants on the same --frames frames (not with --quick): each worker thread on its own CUDA stream (a no-op
-    since the segmenter and tagger do that themselves, host_sync.worker_stream); 1, 2, 8 workers;
-    batch 4 and 16; JPEG decoding on the GPU (torchvision.io.decode_jpeg) against OpenCV.
+  * variants on the same --frames frames (not with --quick): 1, 2, 8 workers; batch 4 and 16; JPEG decoding on the GPU (torchvision.io.decode_jpeg) against OpenCV.
 Writes DIR/profile.json (the timings) and DIR/profile_tables.txt (the profiler tables).
 """
 
@@ -20,8 +19,6 @@ import os
 import sys
 import tempfile
 import time
-from concurrent.futures import ThreadPoolExecutor
-from contextlib import nullcontext
 from pathlib import Path
 from typing import Any
 
@@ -29,62 +26,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
-from bench_models_scene import chat_server, sync, write_frames  # noqa: E402
+from bench_models_scene import chat_server, run_stage, sync, write_frames  # noqa: E402
 
 from react3d_core.atomic import write_json, write_text  # noqa: E402
-
-
-def stage(perception: Any, frames: list[Any], cfg: Any, batch: int, workers: int, streams: bool = False) -> dict[str, Any]:
-    """perceive() + pack_masks per batch in ``workers`` threads; ``streams``: each thread on its own CUDA stream."""
-    import threading
-
-    import torch
-
-    from react3d_core.pipeline import perceive
-    from react3d_core.pipeline.steps import pack_masks
-
-    local = threading.local()
-    batches = [frames[s : s + batch] for s in range(0, len(frames), batch)]
-
-    def one(b: list[Any]) -> int:
-        ctx = nullcontext()
-        if streams and torch.cuda.is_available():
-            if not hasattr(local, "stream"):
-                local.stream = torch.cuda.Stream()
-            ctx = torch.cuda.stream(local.stream)
-        with ctx:
-            r = perceive(perception, b, cfg)
-            pack_masks([r["masks"]])
-        return sum(len(m) for m in r["masks"].values())
-
-    util: list[float] = []
-    done = threading.Event()
-
-    def sample() -> None:  # the device's own utilisation counter (percent of time a kernel ran), every 50 ms
-        while not done.wait(0.05):
-            try:
-                util.append(float(torch.cuda.utilization()))
-            except Exception:  # noqa: BLE001 - no NVML here: no utilisation column
-                return
-
-    sampler = threading.Thread(target=sample, daemon=True)
-    if torch.cuda.is_available():
-        sampler.start()
-    sync()
-    t = time.perf_counter()
-    if workers == 1:  # in this thread: the profiler records only the thread that started it
-        masks = sum(one(b) for b in batches)
-    else:
-        with ThreadPoolExecutor(workers) as ex:
-            masks = sum(ex.map(one, batches))
-    sync()
-    dt = time.perf_counter() - t
-    done.set()
-    row = {"frames": len(frames), "batch": batch, "workers": workers, "streams": streams, "seconds": dt,
-           "ms_per_frame": 1000 * dt / len(frames), "masks": masks}
-    if util:
-        row["gpu_util_mean_pct"] = sum(util) / len(util)
-    return row
 
 
 def profile(perception: Any, frames: list[Any], cfg: Any, batch: int, rows: int) -> tuple[dict[str, Any], str]:
@@ -96,7 +40,7 @@ def profile(perception: Any, frames: list[Any], cfg: Any, batch: int, rows: int)
 
     acts = [ProfilerActivity.CPU] + ([ProfilerActivity.CUDA] if torch.cuda.is_available() else [])
     with tprofile(activities=acts) as prof:
-        row = stage(perception, frames, cfg, batch, 1)
+        row = run_stage(perception, frames, cfg, batch, 1)
     ka = prof.key_averages()
     dev_attr = "self_device_time_total" if hasattr(ka[0], "self_device_time_total") else "self_cuda_time_total"
     # device time of the kernels and copies themselves: the ops that launch them report the same time again
@@ -126,7 +70,7 @@ def python_profile(perception: Any, frames: list[Any], cfg: Any, batch: int, row
 
     pr = cProfile.Profile()
     pr.enable()
-    stage(perception, frames, cfg, batch, 1)
+    run_stage(perception, frames, cfg, batch, 1)
     pr.disable()
     text = io.StringIO()
     st = pstats.Stats(pr, stream=text)
@@ -208,10 +152,10 @@ def main(argv: list[str] | None = None) -> int:
         perception = make_model_perception(cfg)
         perception.segmenter.max_detections = a.max_detections
         fr = frames[: a.frames]
-        stage(perception, frames[: a.batch], cfg, a.batch, 1)  # warm-up
+        run_stage(perception, frames[: a.batch], cfg, a.batch, 1)  # warm-up
         runs: dict[str, Any] = {}
         res["runs"] = runs
-        runs["base"] = stage(perception, fr, cfg, a.batch, a.workers)
+        runs["base"] = run_stage(perception, fr, cfg, a.batch, a.workers)
         print("base", runs["base"], flush=True)
         save()
         summary, tables = profile(perception, frames[: a.profile_frames], cfg, a.batch, a.rows)
@@ -223,19 +167,17 @@ def main(argv: list[str] | None = None) -> int:
         if a.quick:
             srv.shutdown()
             return 0
-        runs["streams"] = stage(perception, fr, cfg, a.batch, a.workers, streams=True)
-        print("streams", runs["streams"], flush=True)
         for w in (1, 2, 8):
-            runs[f"workers{w}"] = stage(perception, fr, cfg, a.batch, w)
+            runs[f"workers{w}"] = run_stage(perception, fr, cfg, a.batch, w)
             print(f"workers{w}", runs[f"workers{w}"], flush=True)
         save()
         for b in (4, 16):
             cfg_b = cfg.model_copy(update={"batch_size": b})
             perception.segmenter.batch_size = perception.tagger.batch_size = b
-            runs[f"batch{b}"] = stage(perception, fr, cfg_b, b, a.workers)
+            runs[f"batch{b}"] = run_stage(perception, fr, cfg_b, b, a.workers)
             print(f"batch{b}", runs[f"batch{b}"], flush=True)
         perception.segmenter.batch_size = perception.tagger.batch_size = a.batch
-        runs["base_again"] = stage(perception, fr, cfg, a.batch, a.workers)
+        runs["base_again"] = run_stage(perception, fr, cfg, a.batch, a.workers)
         print("base_again", runs["base_again"], flush=True)
         res["jpeg"] = jpeg_decode(fr[:32])
         print("jpeg", res["jpeg"], flush=True)

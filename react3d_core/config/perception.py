@@ -78,7 +78,7 @@ class HeuristicConfig(StageConfig):
     handle_len: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
     handle_thick: tuple[float, float] = Field((0.014, 0.07), description="Short side of a handle (m).")
     plain_floor_gap: float = Field(0.03, ge=0, description="Image path: a handle-less front whose bottom edge is this close to the floor (m) is a piece of wall (base units stand on a plinth; room doors have handles); 0: no floor rule.")
-    floor_min_area: float = Field(0.5, ge=0, description="Image path: the floor is the lowest 2 cm band of upward-facing mesh holding at least this area (m^2); none: no floor rule.")
+    floor_min_area: float = Field(0.5, ge=0, description="Image path: the floor is the lowest 2 cm band of upward-facing mesh holding at least this area (m^2), at its area-weighted median height; no such band: no floor rule.")
     handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")
     clutter_cell_median: bool = Field(True, description="Image cells: a pixel is clutter only when it is also off the cell's own median colour (a band along an edge shared with a front of another colour is not).")
     step_over_dip: bool = Field(True, description="Image cells: a colour step along the whole cell that is stronger than the best dark line is the cut (a shaker frame casts a dark line inside its own edge).")

@@ -97,16 +97,15 @@ def floor_height(mesh: TriMesh, min_area: float, band: float = 0.02, min_up: flo
     up = mesh.face_normals[:, 2] > min_up
     if not up.any() or min_area <= 0:
         return None
-    z = mesh.face_centroids[up, 2]
+    z, a = mesh.face_centroids[up, 2], mesh.face_areas[up]
     bins = np.floor((z - z.min()) / band).astype(int)
-    area = np.bincount(bins, weights=mesh.face_areas[up])
-    full = np.flatnonzero(area >= min_area)
+    full = np.flatnonzero(np.bincount(bins, weights=a) >= min_area)
     if not len(full):
         return None
-    inb = bins == full[0]
-    order = np.argsort(z[inb])
-    cum = np.cumsum(mesh.face_areas[up][inb][order])
-    return float(z[inb][order][np.searchsorted(cum, 0.5 * cum[-1])])  # area-weighted median of the band
+    zb, ab = z[bins == full[0]], a[bins == full[0]]
+    order = np.argsort(zb)
+    cum = np.cumsum(ab[order])
+    return float(zb[order][np.searchsorted(cum, 0.5 * cum[-1])])  # area-weighted median of the band
 
 
 def off_the_floor(fronts: list[Front], floor: float | None, gap: float) -> list[Front]:
