@@ -119,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--max-detections", type=int, default=16)
     p.add_argument("--rows", type=int, default=40)
     p.add_argument("--quick", action="store_true", help="only the base run and the profiles")
-    p.add_argument("--out", required=True)
+    p.add_argument("--out", required=True, help="a new or empty folder for profile.json and profile_tables.txt")
     a = p.parse_args(argv)
 
     import torch
@@ -134,6 +134,8 @@ def main(argv: list[str] | None = None) -> int:
     tiny = a.tiny or not gpu
     device = torch.device("cuda" if gpu else "cpu")
     out = Path(a.out)
+    if out.exists() and any(out.iterdir()):
+        p.error(f"--out {a.out}: the folder is not empty; give a new or empty one (profile.json and profile_tables.txt are written there)")
     out.mkdir(parents=True, exist_ok=True)
     res: dict[str, Any] = {"device": torch.cuda.get_device_name(0) if gpu else "cpu", "torch": torch.__version__,
                            "transformers": transformers.__version__, "tiny": tiny, "size": [a.width, a.height]}

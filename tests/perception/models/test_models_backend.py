@@ -135,6 +135,12 @@ def test_stage_profiler_runs_tiny(tmp_path):
     assert r["profile"]["device_kernel_s"] == 0.0 and r["profile"]["self_cpu_s_all_threads"] > 0
     tables = (tmp_path / "p" / "profile_tables.txt").read_text()
     assert "## by self CPU time" in tables and "## Python (cProfile), one worker" in tables and "perceive" in tables
+    mine = tmp_path / "mine"
+    mine.mkdir()
+    (mine / "profile.json").write_text("my own")
+    with pytest.raises(SystemExit):  # a folder the tool did not make is never written into
+        mod.main(["--tiny", "--quick", "--out", str(mine)])
+    assert (mine / "profile.json").read_text() == "my own"
 
 
 def test_local_lm_tag_filter_path(tmp_path):
