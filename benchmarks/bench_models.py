@@ -2,6 +2,7 @@
 
     python3 benchmarks/bench_models.py --json bench_models.json            # GPU: real architectures
     python3 benchmarks/bench_models.py --tiny --json bench_models.json     # CPU smoke run, tiny configs
+    python3 benchmarks/bench_models.py --mask-transfer --models "" --json mask_transfer.json   # GPU: masks to host only
 
 Models are built from configs with random weights (nothing is downloaded): SAM ViT-H and ViT-B image
 encoders at 1024x1024, Grounding DINO-T (Swin-T + BERT-base, transformers' default config) at
@@ -9,6 +10,8 @@ encoders at 1024x1024, Grounding DINO-T (Swin-T + BERT-base, transformers' defau
   * reference: fp32, batch 1, the model built anew for every call (as per-frame scripts do);
     reported both as forward-only img/s and img/s including the rebuild;
   * ours: built once, bf16 on GPU (fp32 on CPU), batches of --batch frames, torch.inference_mode.
+``--mask-transfer`` (CUDA only) also times 16 bool masks of 1920x1440 from the GPU to numpy: a plain
+``.cpu().numpy()`` against host_sync.masks_to_host (bits packed on the GPU, unpacked on the host).
 Prints a table and writes JSON. Without a GPU the real sizes take minutes per call, so ``--tiny``
 (automatic on CPU unless --full) uses few-layer configs: the numbers then only show the code runs.
 """
@@ -115,6 +118,34 @@ def bench_one(name: str, build: Callable[[], Any], run: Callable[..., Any], devi
     return row
 
 
+def mask_transfer(device: Any, n: int = 16, hw: tuple[int, int] = (1440, 1920), repeats: int = 20) -> dict[str, Any] | None:
+    """Median ms of bool masks (n,H,W) on the GPU -> numpy: plain ``.cpu().numpy()`` vs ``masks_to_host``."""
+    import statistics
+
+    import numpy as np
+    import torch
+
+    from tasks.models.host_sync import masks_to_host
+
+    if device.type != "cuda":
+        print("--mask-transfer needs a CUDA device: skipped")
+        return None
+    g = torch.Generator(device).manual_seed(0)
+    m = torch.rand((n, *hw), device=device, generator=g) < 0.3
+    ways = {"plain_cpu_numpy": lambda: m.cpu().numpy(), "masks_to_host": lambda: masks_to_host(m)}
+    assert np.array_equal(ways["plain_cpu_numpy"](), ways["masks_to_host"]())
+    row: dict[str, Any] = {"masks": n, "height": hw[0], "width": hw[1], "repeats": repeats, "bool_mb": m.numel() / 1e6}
+    for name, fn in ways.items():
+        for _ in range(3):  # warm-up (pinned host blocks, kernels)
+            fn()
+        row[f"{name}_ms"] = 1000 * statistics.median(timed(fn, device) for _ in range(repeats))
+    row["speedup"] = row["plain_cpu_numpy_ms"] / row["masks_to_host_ms"]
+    print(f"masks to host, {n} x {hw[0]}x{hw[1]} bool ({row['bool_mb']:.0f} MB), median of {repeats}: "
+          f"plain .cpu().numpy() {row['plain_cpu_numpy_ms']:.2f} ms, masks_to_host {row['masks_to_host_ms']:.2f} ms "
+          f"({row['speedup']:.1f}x)")
+    return row
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--tiny", action="store_true", help="few-layer configs (automatic without a GPU unless --full)")
@@ -122,7 +153,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--batch", type=int, default=8)
     p.add_argument("--images", type=int, default=16, help="images per measurement")
     p.add_argument("--rebuild-calls", type=int, default=2)
-    p.add_argument("--models", default="sam_vit_h,sam_vit_b,gdino_t")
+    p.add_argument("--models", default="sam_vit_h,sam_vit_b,gdino_t", help='comma-separated; "" for none')
+    p.add_argument("--mask-transfer", action="store_true", help="also time 16 1920x1440 masks GPU -> numpy (CUDA only)")
     p.add_argument("--dtype", default="auto", help="ours: auto (bf16 on GPU, fp32 on CPU), bf16, fp16, fp32")
     p.add_argument("--json", default=None)
     a = p.parse_args(argv)
@@ -140,7 +172,7 @@ def main(argv: list[str] | None = None) -> int:
     specs = {"sam_vit_h": lambda: sam_spec("vit_h", tiny), "sam_vit_b": lambda: sam_spec("vit_b", tiny),
              "gdino_t": lambda: gdino_spec(tiny)}
     rows = []
-    for name in a.models.split(","):
+    for name in filter(None, (x.strip() for x in a.models.split(","))):
         build, run = specs[name.strip()]()
         rows.append(bench_one(name.strip(), build, run, device, dtype, a.batch, a.images, a.rebuild_calls))
     dev_name = torch.cuda.get_device_name(device) if device.type == "cuda" else "cpu"
@@ -150,9 +182,13 @@ def main(argv: list[str] | None = None) -> int:
     for r in rows:
         table.add_row(r["model"], f"{r['ref_fp32_b1_img_s']:.2f}", f"{r['ref_rebuild_img_s']:.2f}", f"{r['ours_img_s']:.2f}",
                       f"{r['speedup_vs_ref']:.1f}x")
-    Console().print(table)
+    if rows:
+        Console().print(table)
+    result: dict[str, Any] = {"device": dev_name, "tiny": tiny, "torch": torch.__version__, "rows": rows}
+    if a.mask_transfer:
+        result["mask_transfer"] = mask_transfer(device)
     if a.json:
-        write_json(a.json, {"device": dev_name, "tiny": tiny, "torch": torch.__version__, "rows": rows})
+        write_json(a.json, result)
     return 0
 
 

@@ -316,6 +316,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--sam", default="vit_h", choices=["vit_h", "vit_b"])
     p.add_argument("--quick", action="store_true", help="only the whole-scene run, one per-call batch and the reference")
     p.add_argument("--work", default=None, help="a new or empty folder for checkpoints and frames (default: a temporary one)")
+    p.add_argument("--plain-mask-copy", action="store_true",
+                   help="the 'before' of the mask bit-packing: SAM masks cross to the host one byte per pixel (plain .cpu())")
     p.add_argument("--json", default=None)
     a = p.parse_args(argv)
 
@@ -327,6 +329,10 @@ def main(argv: list[str] | None = None) -> int:
     from tasks.models.random_checkpoints import save_random_checkpoints
     from tasks.models.runtime import clear_cache
 
+    if a.plain_mask_copy:
+        from tasks.models import grounded_sam
+
+        grounded_sam.masks_to_host = lambda m: m.cpu().numpy()  # type: ignore[assignment]
     gpu = torch.cuda.is_available()
     tiny = a.tiny or not gpu
     device = torch.device("cuda" if gpu else "cpu")
@@ -338,7 +344,7 @@ def main(argv: list[str] | None = None) -> int:
     work = Path(a.work or work_ctx.name)  # type: ignore[union-attr]
     result: dict[str, Any] = {"device": torch.cuda.get_device_name(0) if gpu else "cpu", "torch": torch.__version__,
                               "tiny": tiny, "frames": a.frames, "size": [a.width, a.height], "sam": a.sam,
-                              "max_detections": a.max_detections}
+                              "max_detections": a.max_detections, "mask_copy": "plain" if a.plain_mask_copy else "packed"}
 
     def save() -> None:  # after every section: a run cut short still leaves what it measured
         if a.json:

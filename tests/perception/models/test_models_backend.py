@@ -98,6 +98,27 @@ def test_benchmark_runs_tiny(tmp_path):
     assert all(r["ours_img_s"] > 0 and r["ref_fp32_b1_img_s"] > 0 and r["ref_rebuild_img_s"] > 0 for r in rows)
 
 
+def test_mask_transfer_benchmark_flag(tmp_path):
+    """bench_models.py --mask-transfer with no models: on the CPU it says it needs CUDA and writes null."""
+    import importlib.util
+    from pathlib import Path
+
+    import torch
+
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "bench_models.py"
+    spec = importlib.util.spec_from_file_location("bench_models", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = tmp_path / "m.json"
+    assert mod.main(["--mask-transfer", "--models", "", "--json", str(out)]) == 0
+    r = json.loads(out.read_text())
+    assert r["rows"] == []
+    if torch.cuda.is_available():
+        assert r["mask_transfer"]["plain_cpu_numpy_ms"] > 0 and r["mask_transfer"]["masks_to_host_ms"] > 0
+    else:
+        assert r["mask_transfer"] is None
+
+
 def test_scene_benchmark_runs_tiny(tmp_path):
     """benchmarks/bench_models_scene.py --quick on tiny models (CPU): the stage over real JPEG files,
     every frame accounted for, masks capped per frame, reference timings present."""

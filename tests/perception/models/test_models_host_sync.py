@@ -1,15 +1,18 @@
 """host_sync: SAM's relative-position tables cached per layer (same embeddings), transformers' input checks
-switched off only when the user has not chosen, and the per-thread stream a no-op on the CPU."""
+switched off only when the user has not chosen, the per-thread stream a no-op on the CPU, and masks packed
+8 pixels per byte before they cross the bus (np.packbits' layout, exact round trip)."""
 
 from __future__ import annotations
 
 import threading
 
+import numpy as np
 import pytest
 import torch
 from transformers import SamModel
 
-from tasks.models.host_sync import cache_sam_relative_positions, skip_shape_checks, worker_stream
+from tasks.models.host_sync import (cache_sam_relative_positions, masks_to_host, pack_bits, skip_shape_checks,
+                                    worker_stream)
 from tasks.models.random_checkpoints import sam_config
 
 
@@ -109,6 +112,72 @@ def test_worker_stream_is_a_no_op_on_the_cpu():
     for t in threads:
         t.join()
     assert seen == [True, True, True]
+
+
+_MASK_SHAPES = [(3, 37, 53), (0, 5, 5), (1, 1, 1), (2, 8, 8), (4, 3, 7), (16, 48, 64)]
+
+
+def _random_masks(shape: tuple[int, int, int], seed: int) -> torch.Tensor:
+    return torch.rand(shape, generator=torch.Generator().manual_seed(seed)) < 0.4
+
+
+@pytest.mark.parametrize("shape", _MASK_SHAPES)
+def test_pack_bits_is_numpys_packbits_and_round_trips(shape):
+    m = _random_masks(shape, sum(shape))
+    n, h, w = shape
+    flat = m.reshape(n, h * w)
+    packed = pack_bits(flat)
+    assert packed.dtype == torch.uint8 and packed.shape == (n, (h * w + 7) // 8)
+    assert np.array_equal(packed.numpy(), np.packbits(flat.numpy(), axis=-1))  # same bit order, zero padding
+    back = np.unpackbits(packed.numpy(), count=h * w, axis=-1).view(bool).reshape(shape)
+    assert np.array_equal(back, m.numpy())
+
+
+def test_pack_bits_counts_non_zero_as_true_and_packs_the_last_axis_of_any_shape():
+    x = torch.randint(-2, 3, (2, 3, 11), generator=torch.Generator().manual_seed(3)).float()
+    assert np.array_equal(pack_bits(x).numpy(), np.packbits(x.numpy() != 0, axis=-1))
+    assert pack_bits(torch.ones(8, dtype=torch.bool)).tolist() == [255]
+    assert pack_bits(torch.tensor([True] + [False] * 8)).tolist() == [128, 0]
+
+
+def test_masks_to_host_on_the_cpu_is_the_tensors_own_memory():
+    m = _random_masks((3, 37, 53), 5)
+    out = masks_to_host(m)
+    assert out.dtype == bool and out.shape == (3, 37, 53) and np.array_equal(out, m.numpy())
+    assert np.shares_memory(out, m.numpy())  # no packing, no copy on the CPU
+    assert masks_to_host(torch.zeros(0, 4, 6, dtype=torch.bool)).shape == (0, 4, 6)
+
+
+@pytest.mark.gpu
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device")
+@pytest.mark.parametrize("shape", _MASK_SHAPES + [(16, 1440, 1920)])
+def test_masks_to_host_on_cuda_equals_a_plain_copy(shape):
+    m = _random_masks(shape, sum(shape)).to("cuda")
+    out = masks_to_host(m)
+    assert out.dtype == bool and out.shape == shape
+    assert np.array_equal(out, m.cpu().numpy())
+    flat = m.reshape(shape[0], shape[1] * shape[2])
+    assert np.array_equal(pack_bits(flat).cpu().numpy(), np.packbits(flat.cpu().numpy(), axis=-1))
+
+
+@pytest.mark.gpu
+@pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device")
+def test_masks_to_host_on_a_worker_stream_waits_for_that_stream():
+    dev = torch.device("cuda")
+    results: dict[int, bool] = {}
+
+    def body(i: int) -> None:
+        with worker_stream(dev):
+            big = torch.rand((8, 1440, 1920), device=dev, generator=torch.Generator(dev).manual_seed(i))
+            m = big < 0.5  # queued on this thread's stream just before the copy
+            results[i] = bool(np.array_equal(masks_to_host(m), m.cpu().numpy()))
+
+    threads = [threading.Thread(target=body, args=(i,)) for i in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert results == {0: True, 1: True, 2: True}
 
 
 @pytest.mark.gpu
