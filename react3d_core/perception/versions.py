@@ -6,7 +6,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # colour steps beat weaker dark lines, line structure and the cell's own colour in the clutter test;
 # 7: enclosed handle-shaped unseen holes are handles (wall-cabinet flaps), mirrored background border;
 # 8: a cell holding a handle may be more cluttered (max_clutter_handle 0.3: raised-panel doors);
-# 9: a handle-less image front reaching down to the floor is wall (plain_floor_gap)
-HEURISTIC_VERSION = "9"
+# 9: a handle-less image front reaching down to the floor is wall (plain_floor_gap);
+# 10: a wide vertical plane's direction is refit from its faces' positions (plane_refit_deg)
+HEURISTIC_VERSION = "10"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

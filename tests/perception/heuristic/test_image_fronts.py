@@ -479,3 +479,67 @@ def test_handle_less_fronts_reaching_the_floor_are_wall() -> None:
     wall, drawer, door = front(0.0, False), front(0.05, False), front(0.0, True)
     assert off_the_floor([wall, drawer, door], 0.001, 0.03) == [drawer, door]
     assert off_the_floor([wall, drawer, door], None, 0.03) == [wall, drawer, door]
+
+
+def _line_points(theta_deg: float, d: float, t0: float, t1: float, step: float = 0.01) -> np.ndarray:
+    """Points of the vertical plane with horizontal normal at ``theta_deg`` and offset ``d``, for tangent
+    coordinates t0..t1 (in the xy plane)."""
+    th = np.radians(theta_deg)
+    n, t = np.array([np.cos(th), np.sin(th)]), np.array([-np.sin(th), np.cos(th)])
+    ts = np.arange(t0, t1 + 1e-9, step)
+    return d * n + ts[:, None] * t
+
+
+def test_fit_direction_hand_computed() -> None:
+    """A 2.5 m wall turned by 0.5 degrees, a curved door 1-4 cm behind it over 0.8 m, and normals whose
+    mean is skewed to 1.5 degrees: the positions give the wall's direction (to the 0.1 degree search step)
+    and offset; a piece narrower than 1 m keeps the normals' direction."""
+    from react3d_core.perception.heuristic.planes import fit_direction
+
+    wall = _line_points(-89.5, 3.72, 0.0, 2.5)
+    door = _line_points(-89.5, 3.75, -0.8, -0.01)
+    door = door + np.linspace(0.0, 0.03, len(door))[:, None] * np.array([np.cos(np.radians(-89.5)), np.sin(np.radians(-89.5))])
+    xy = np.concatenate([wall, door])
+    w = np.ones(len(xy))
+    nd = np.array([np.cos(np.radians(-88.5)), np.sin(np.radians(-88.5)), 0.0])
+    n, d = fit_direction(xy, w, nd, 3.0)
+    assert np.degrees(np.arctan2(n[1], n[0])) == pytest.approx(-89.5, abs=0.051)
+    assert n[2] == 0.0 and np.linalg.norm(n) == pytest.approx(1.0)
+    assert d == pytest.approx(3.72, abs=0.006)  # the 1 cm window holding the wall
+    narrow = _line_points(-89.5, 3.72, 0.0, 0.9)
+    n2, d2 = fit_direction(narrow, np.ones(len(narrow)), nd, 3.0)
+    assert n2 is nd and d2 == pytest.approx(float(np.mean(narrow @ nd[:2])))
+
+
+def test_fit_direction_keeps_parallel_layers_apart() -> None:
+    """A wall with a door leaf 2 cm in front of it along part of its length: turning the plane so that the
+    wall's far end meets the leaf piles one 1 cm window higher, but smears both layers; the fit stays
+    parallel to both (every layer sharp at once)."""
+    from react3d_core.perception.heuristic.planes import fit_direction
+
+    wall = np.concatenate([_line_points(0.0, 0.0, 0.0, 1.2), _line_points(0.0, 0.0, 2.1, 2.7)])
+    leaf = _line_points(0.0, 0.02, 1.2, 2.1)
+    xy = np.concatenate([wall, leaf])
+    n, d = fit_direction(xy, np.ones(len(xy)), np.array([1.0, 0.0, 0.0]), 3.0)
+    assert abs(np.degrees(np.arctan2(n[1], n[0]))) < 0.051
+    assert d == pytest.approx(0.0, abs=0.006)
+
+
+def test_vertical_plane_beside_a_curved_door_is_not_turned() -> None:
+    """A flat 2.5 m base run beside a curved fridge door: the normals' mean leans towards the curve; with
+    the direction refit from positions the plane stays parallel to the run, so both of its ends are
+    within 5 mm of it (without, the far end drifts)."""
+    grey = lambda x, z: np.full((len(x), 3), 150, np.uint8)  # noqa: E731
+    run = _grid_mesh(0.0, 2.5, 0.0, 0.9, 2.0, 0.02, grey)
+    fridge = _grid_mesh(-0.8, -0.02, 0.0, 1.8, 2.0, 0.02, grey)
+    s = (fridge.vertices[:, 0] + 0.8) / 0.8
+    fridge.vertices[:, 1] = 2.01 + 0.04 * s ** 2  # bulges out towards +y, its normals turned one way
+    mesh = _merge(run, fridge)
+    cam = np.array([1.0, 0.0, 1.2])
+    ends = np.array([[0.05, 2.0, 0.5], [2.45, 2.0, 0.5]])
+    off = {}
+    for r in (0.0, 3.0):
+        p = max(vertical_planes(mesh, cam, min_area=0.2, refit_deg=r), key=lambda q: q.area)
+        off[r] = np.abs(ends @ p.n - p.d)
+    assert off[3.0].max() < 0.005, off
+    assert off[0.0].max() > off[3.0].max(), off
