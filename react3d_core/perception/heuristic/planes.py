@@ -61,7 +61,8 @@ def _peaks(hist: np.ndarray, min_weight: float, min_sep: int, circular: bool) ->
 
 def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 0.3, angle_tol_deg: float = 12.0,
                     offset_tol: float = 0.025, min_area: float = 0.08, cell: float = 0.04,
-                    view_dirs: np.ndarray | None = None, refit_deg: float = 3.0) -> list[Plane]:
+                    view_dirs: np.ndarray | None = None, refit_deg: float = 3.0,
+                    keep_share: float = 0.9) -> list[Plane]:
     """Vertical planes of at least ``min_area`` m².
 
     A face belongs to a plane when its normal is within ``angle_tol_deg`` of the plane's horizontal
@@ -108,7 +109,13 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
             n_fit = nd
             if refit_deg > 0:  # the face positions fix a wide plane's direction better than its (noisy, skewed) normals
                 n_fit, d_fit = fit_direction(cen[sel, :2], area[sel], nd, refit_deg)
-                sel = idx_near[(np.abs(cen[idx_near] @ n_fit - d_fit) <= offset_tol) & ~used[idx_near]]
+                refit = idx_near[(np.abs(cen[idx_near] @ n_fit - d_fit) <= offset_tol) & ~used[idx_near]]
+                # straightened, the plane keeps (nearly) all it had; turned onto another surface, it does not
+                if area[np.intersect1d(refit, sel, assume_unique=True)].sum() >= keep_share * area[sel].sum():
+                    sel = refit
+                else:
+                    n_fit = nd
+                    sel = sel[~used[sel]]
                 if area[sel].sum() < min_area:
                     continue
                 used[sel] = True
@@ -137,10 +144,11 @@ def fit_direction(xy: np.ndarray, w: np.ndarray, nd: np.ndarray, max_angle_deg: 
 
     Why: a curved appliance door beside a flat cabinet run skews the normals' mean by a degree, which
     over 2.5 m moves the plane's far end by the offset tolerance; the flat faces' positions do not skew.
-    Points spanning less than ``min_extent`` along the plane give ``nd`` back (with the weighted mean
-    offset): over a short piece, positions fix the direction no better than normals do."""
-    t = np.array([-nd[1], nd[0]])
-    if len(xy) < 3 or np.ptp(xy @ t) < min_extent:
+    Points without an unbroken stretch of ``min_extent`` along the plane (pieces of several cabinets at
+    about the same offset do not count) give ``nd`` back (with the weighted mean offset): over a short
+    piece, positions fix the direction no better than normals do, and separate pieces may lie on
+    slightly different planes."""
+    if len(xy) < 3 or _longest_run(xy @ np.array([-nd[1], nd[0]]), 0.04) < min_extent:
         return nd, float(np.average(xy @ nd[:2], weights=w))
     a0 = np.arctan2(nd[1], nd[0])
     angs = a0 + np.radians(np.arange(-max_angle_deg, max_angle_deg + 1e-9, step_deg))
@@ -157,6 +165,15 @@ def fit_direction(xy: np.ndarray, w: np.ndarray, nd: np.ndarray, max_angle_deg: 
     b = int(np.argmax(hist[k]))
     n2 = dirs[k]
     return np.array([n2[0], n2[1], 0.0]), float(lo[k] + (b + 0.5) * bin_m)
+
+
+def _longest_run(t: np.ndarray, step: float) -> float:
+    """Length of the longest unbroken stretch of the coordinates ``t`` on a ``step`` grid."""
+    occ = np.zeros(int((t.max() - t.min()) / step) + 1, bool)
+    occ[((t - t.min()) / step).astype(int)] = True
+    padded = np.concatenate([[False], occ, [False]]).astype(np.int8)
+    edges = np.flatnonzero(np.diff(padded))
+    return float((edges[1::2] - edges[::2]).max() * step)
 
 
 def _flip(p: Plane) -> Plane:
