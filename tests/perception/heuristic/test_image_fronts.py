@@ -543,3 +543,24 @@ def test_vertical_plane_beside_a_curved_door_is_not_turned() -> None:
         off[r] = np.abs(ends @ p.n - p.d)
     assert off[3.0].max() < 0.005, off
     assert off[0.0].max() > off[3.0].max(), off
+
+
+def test_longest_run_hand_computed() -> None:
+    from react3d_core.perception.heuristic.planes import _longest_run
+
+    t = np.array([0.0, 0.01, 0.05, 0.09, 0.5, 0.52])  # 4 cm cells 0, 0, 1, 2, 12, 13: runs of 3 and 2 cells
+    assert _longest_run(t, 0.04) == pytest.approx(0.12)
+    assert _longest_run(np.array([1.0]), 0.04) == pytest.approx(0.04)
+
+
+def test_fit_direction_leaves_separate_short_pieces_alone() -> None:
+    """Two 0.6 m cabinets 0.5 m apart, 1 cm apart in depth, span 1.7 m but no unbroken metre: turning the
+    plane would line them up (a sharper density), yet they are two surfaces; the normals' direction stays."""
+    from react3d_core.perception.heuristic.planes import fit_direction
+
+    xy = np.concatenate([_line_points(0.0, 0.0, 0.0, 0.6), _line_points(0.0, 0.01, 1.1, 1.7)])
+    nd = np.array([1.0, 0.0, 0.0])
+    n, _ = fit_direction(xy, np.ones(len(xy)), nd, 3.0)
+    assert n is nd
+    n_joined, _ = fit_direction(xy, np.ones(len(xy)), nd, 3.0, min_extent=0.5)  # allowed, it would turn
+    assert abs(np.degrees(np.arctan2(n_joined[1], n_joined[0]))) > 0.2
