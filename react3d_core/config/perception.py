@@ -98,6 +98,7 @@ class HeuristicConfig(StageConfig):
     plane_offset_tol: float = Field(0.025, ge=0, description="Image path: faces this close to a vertical plane belong to it (m).")
     plane_angle_tol_deg: float = Field(12.0, ge=0, description="Image path: faces whose normal is within this of a plane's belong to it (deg).")
     plane_refit_deg: float = Field(3.0, ge=0, description="Image path: a plane at least 1 m wide takes, within this of its normals' mean direction, the direction along which its faces' positions are sharpest (a curved appliance door skews the normals; deg, 0: off).")
+    plane_refit_min_gain: float = Field(1.4, ge=1, description="Image path: ... only when the offsets are at least this many times sharper (integral of the squared density) than along the normals' direction.")
     min_plane_area: float = Field(0.08, ge=0, description="Image path: smallest vertical plane photographed (m^2; at least min_w x min_h).")
     plane_cell: float = Field(0.04, gt=0, description="Image path: pieces of one plane farther apart than this are separate planes (m).")
     plane_min_fragment_area: float = Field(0.03, ge=0, description="Image path: fragments of a plane's coverage smaller than this are not part of it (m^2).")

@@ -38,6 +38,7 @@ class ImageFrontParams:
     plane_offset_tol: float = _H.plane_offset_tol        # m: faces this close to a plane belong to it
     plane_angle_tol_deg: float = _H.plane_angle_tol_deg
     plane_refit_deg: float = _H.plane_refit_deg          # deg: direction search from face positions (0: off)
+    plane_refit_min_gain: float = _H.plane_refit_min_gain  # ... taken only when this much sharper
     min_plane_area: float = _H.min_plane_area            # m²
     plane_cell: float = _H.plane_cell                    # m: pieces of one plane farther apart are separate planes
     plane_min_fragment_area: float = _H.plane_min_fragment_area  # m²: smaller coverage fragments are not the plane's
@@ -72,6 +73,7 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
                          texture_factor=cfg.texture_factor, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
                          step_z=cfg.step_z, max_depth=cfg.max_split_depth, step_over_dip=cfg.step_over_dip),
         plane_offset_tol=cfg.plane_offset_tol, plane_angle_tol_deg=cfg.plane_angle_tol_deg, plane_refit_deg=cfg.plane_refit_deg,
+        plane_refit_min_gain=cfg.plane_refit_min_gain,
         min_plane_area=cfg.min_plane_area, plane_cell=cfg.plane_cell, plane_min_fragment_area=cfg.plane_min_fragment_area,
         face_depth=tuple(cfg.face_depth), outline_fill_px=cfg.outline_fill_px,
         protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
@@ -215,7 +217,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, 3))
     planes = vertical_planes(mesh, cams.mean(0), max_tilt=rules.max_tilt, angle_tol_deg=params.plane_angle_tol_deg,
                              offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h),
-                             cell=params.plane_cell, refit_deg=params.plane_refit_deg)
+                             cell=params.plane_cell, refit_deg=params.plane_refit_deg,
+                             refit_min_gain=params.plane_refit_min_gain)
     orthos, calib = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
     centroids, normals = mesh.face_centroids, mesh.face_normals
     fronts: list[Front] = []
