@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import json
 import shutil
-import time
 from pathlib import Path
 
 import pytest
@@ -41,9 +40,7 @@ def scene(synthetic_scene) -> Path:  # noqa: ANN001
 
 def test_convert_then_everything_cached(scene: Path, tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
     cfg = {**CFG, "perception": {"backend": "oracle", "oracle": {"seed": 11}}}  # keys unique to this test
-    t0 = time.perf_counter()
     manifest = convert_scene(str(scene), str(tmp_path / "a"), cfg)
-    first = time.perf_counter() - t0
     m = InteractiveScene.load(manifest)
     assert m.objects and (tmp_path / "a" / "export" / "urdf" / "scene.urdf").exists()
     assert (tmp_path / "a" / "report.html").exists() and (tmp_path / "a" / "metrics.json").exists()
@@ -51,9 +48,7 @@ def test_convert_then_everything_cached(scene: Path, tmp_path: Path, monkeypatch
     assert m.config["perception"]["backend"] == "oracle" and "react3d_core.fusion" in m.versions
     counts = [_counting(monkeypatch, mod, fn) for mod, fn in ((t_perc, "perceive_body"), (t_seg, "segment_body"),
                                                              (t_art, "articulate_body"))]
-    t0 = time.perf_counter()
     manifest2 = convert_scene(str(scene), str(tmp_path / "b"), cfg)  # another output folder: same content keys
-    second = time.perf_counter() - t0
     assert [len(c) for c in counts] == [0, 0, 0]
     assert len(InteractiveScene.load(manifest2).objects) == len(m.objects)
     # the same scan copied elsewhere hits the same cache, and the result refers to the copy's mesh
@@ -63,7 +58,6 @@ def test_convert_then_everything_cached(scene: Path, tmp_path: Path, monkeypatch
     assert [len(c) for c in counts] == [0, 0, 0]
     m3 = InteractiveScene.load(manifest3)
     assert (Path(manifest3).parent / m3.input_mesh).resolve() == (copy / "scans" / "mesh_aligned_0.05.ply").resolve()
-    assert second <= 0.2 * first + 1.0, (first, second)  # +1 s: the flow run's fixed start-up on a busy machine
 
 
 def test_resume_after_crash(scene: Path, tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
