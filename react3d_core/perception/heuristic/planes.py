@@ -109,9 +109,11 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
             n_fit = nd
             if refit_deg > 0:  # the face positions fix a wide plane's direction better than its (noisy, skewed) normals
                 n_fit, d_fit = fit_direction(cen[sel, :2], area[sel], nd, refit_deg, min_gain=refit_min_gain)
-                refit = idx_near[(np.abs(cen[idx_near] @ n_fit - d_fit) <= offset_tol) & ~used[idx_near]]
+                refit = None
+                if n_fit is not nd:
+                    refit = idx_near[(np.abs(cen[idx_near] @ n_fit - d_fit) <= offset_tol) & ~used[idx_near]]
                 # straightened, the plane keeps (nearly) all it had; turned onto another surface, it does not
-                if n_fit is not nd and area[np.intersect1d(refit, sel, assume_unique=True)].sum() >= keep_share * area[sel].sum():
+                if refit is not None and area[np.intersect1d(refit, sel, assume_unique=True)].sum() >= keep_share * area[sel].sum():
                     sel = refit
                 else:
                     n_fit = nd

@@ -81,15 +81,21 @@ def test_select_tags_hand_computed():
     assert select_tags(probs, ["a", "b", "c", "d"], top_k=1, min_prob=0.0) == [["a"], ["c"]]
 
 
-def test_benchmark_runs_tiny(tmp_path):
-    """benchmarks/bench_models.py end to end on tiny configs (CPU): table + JSON with the three columns."""
+def _benchmark(name: str):  # noqa: ANN202
+    """The module benchmarks/<name>.py (a script folder, not a package on the path)."""
     import importlib.util
     from pathlib import Path
 
-    path = Path(__file__).resolve().parents[3] / "benchmarks" / "bench_models.py"
-    spec = importlib.util.spec_from_file_location("bench_models", path)
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
+    return mod
+
+
+def test_benchmark_runs_tiny(tmp_path):
+    """benchmarks/bench_models.py end to end on tiny configs (CPU): table + JSON with the three columns."""
+    mod = _benchmark("bench_models")
     out = tmp_path / "b.json"
     assert mod.main(["--tiny", "--images", "2", "--batch", "2", "--rebuild-calls", "1", "--models", "gdino_t,sam_vit_b",
                      "--json", str(out)]) == 0
@@ -100,15 +106,7 @@ def test_benchmark_runs_tiny(tmp_path):
 
 def test_mask_transfer_benchmark_flag(tmp_path):
     """bench_models.py --mask-transfer with no models: on the CPU it says it needs CUDA and writes null."""
-    import importlib.util
-    from pathlib import Path
-
-    import torch
-
-    path = Path(__file__).resolve().parents[3] / "benchmarks" / "bench_models.py"
-    spec = importlib.util.spec_from_file_location("bench_models", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _benchmark("bench_models")
     out = tmp_path / "m.json"
     assert mod.main(["--mask-transfer", "--models", "", "--json", str(out)]) == 0
     r = json.loads(out.read_text())
@@ -122,13 +120,7 @@ def test_mask_transfer_benchmark_flag(tmp_path):
 def test_scene_benchmark_runs_tiny(tmp_path):
     """benchmarks/bench_models_scene.py --quick on tiny models (CPU): the stage over real JPEG files,
     every frame accounted for, masks capped per frame, reference timings present."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[3] / "benchmarks" / "bench_models_scene.py"
-    spec = importlib.util.spec_from_file_location("bench_models_scene", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _benchmark("bench_models_scene")
     out = tmp_path / "s.json"
     assert mod.main(["--tiny", "--quick", "--frames", "4", "--width", "96", "--height", "72", "--batch", "2", "--workers", "2",
                      "--ref-frames", "1", "--max-detections", "3", "--box-threshold", "0.0", "--work", str(tmp_path / "w"),
@@ -142,13 +134,7 @@ def test_scene_benchmark_runs_tiny(tmp_path):
 def test_stage_profiler_runs_tiny(tmp_path):
     """benchmarks/profile_models_stage.py --quick on tiny models (CPU): the base run, the profiler tables
     (ops and Python functions) and no device time without a device."""
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[3] / "benchmarks" / "profile_models_stage.py"
-    spec = importlib.util.spec_from_file_location("profile_models_stage", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    mod = _benchmark("profile_models_stage")
     assert mod.main(["--tiny", "--quick", "--frames", "4", "--profile-frames", "4", "--width", "96", "--height", "72",
                      "--batch", "2", "--workers", "2", "--out", str(tmp_path / "p")]) == 0
     r = json.loads((tmp_path / "p" / "profile.json").read_text())
