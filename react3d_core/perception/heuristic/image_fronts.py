@@ -11,7 +11,7 @@ mesh fronts (handle position and shape, neighbours).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import cv2
 import numpy as np
@@ -23,6 +23,7 @@ from ...raster import Rasterizer
 from .front_cells import Cell, CellParams, Handle, find_handles, off_background, off_threshold, split_cells
 from .fronts import Front, FrontRules, _joint, _neighbours, doors_in_rows
 from .orthophoto import ColourCalibration, Orthophoto, OrthoParams, build_orthophotos
+from .view_registration import RegistrationParams
 from .planes import Plane, vertical_planes
 
 
@@ -63,7 +64,10 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
                           min_cos=cfg.ortho_min_cos, render_scale=cfg.ortho_render_scale, erode_px=cfg.ortho_erode_px,
                           edge_jump=cfg.ortho_edge_jump, depth_tol=cfg.ortho_depth_tol, margin=cfg.ortho_margin,
                           calibrate=cfg.calibrate_colour, scale_range=tuple(cfg.calib_scale_range),
-                          shift_range_px=cfg.calib_shift_range_px, min_gain=cfg.calib_min_gain),
+                          shift_range_px=cfg.calib_shift_range_px, min_gain=cfg.calib_min_gain,
+                          register=RegistrationParams(sigmas_px=tuple(cfg.register_sigmas_px),
+                                                      prior_scale=cfg.register_prior_scale,
+                                                      prior_shift_px=cfg.register_prior_shift_px)),
         cells=CellParams(seam_contrast=cfg.seam_contrast, seam_span=cfg.seam_span, seam_prominence=cfg.seam_prominence,
                          seam_prominence_h=cfg.seam_prominence_h, min_front=cfg.min_front_side,
                          handle_contrast=cfg.handle_contrast, handle_len=tuple(cfg.handle_len),
@@ -92,6 +96,7 @@ class ImageFronts:
     planes: list[Plane]
     orthophotos: list[Orthophoto]
     calibration: ColourCalibration
+    registration: dict[int, ColourCalibration] = field(default_factory=dict)  # per-view correction by frame index
 
 
 def floor_height(mesh: TriMesh, min_area: float, band: float = 0.02, min_up: float = 0.9) -> float | None:
@@ -219,7 +224,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                              offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h),
                              cell=params.plane_cell, refit_deg=params.plane_refit_deg,
                              refit_min_gain=params.plane_refit_min_gain)
-    orthos, calib = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
+    orthos, calib, per_view = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
     centroids, normals = mesh.face_centroids, mesh.face_normals
     fronts: list[Front] = []
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
@@ -272,7 +277,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, params)})
-    return ImageFronts(fronts, vetoed, planes, orthos, calib)
+    return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view)
 
 
 def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.ndarray | None:

@@ -24,7 +24,10 @@ import numpy as np
 from ...config.perception import HeuristicConfig
 from ...data.frames import Frame
 from ...raster import Rasterizer
+from .colour_sampling import ColourCalibration, Points as _Points, nanmedian as _nanmedian, \
+    pixel_coords as _pixel_coords, remap_points as _remap_points
 from .planes import Plane
+from .view_registration import RegistrationParams, register_views
 
 _H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic.ortho_*, calib_*)
 
@@ -46,6 +49,7 @@ class OrthoParams:
     scale_range: tuple[float, float] = _H.calib_scale_range
     shift_range_px: float = _H.calib_shift_range_px  # at 640 px image width
     min_gain: float = _H.calib_min_gain          # a calibration must cut the disagreement by this fraction to be used
+    register: RegistrationParams = RegistrationParams()  # per-view correction on top of the scene calibration
 
 
 @dataclass
@@ -70,18 +74,6 @@ class Orthophoto:
                 self.v_top - (np.asarray(rows, float) + 0.5) * self.res)
 
 
-@dataclass(frozen=True)
-class ColourCalibration:
-    """Correction of the colour intrinsics: fx, fy scaled by ``scale``; cx, cy shifted by (dx, dy)
-    pixels at 640 px width; disagreement between views before and after."""
-
-    scale: float = 1.0
-    dx: float = 0.0
-    dy: float = 0.0
-    before: float = 0.0
-    after: float = 0.0
-
-
 @dataclass
 class _View:
     """What one view sees of a plane's grid, cropped to the rows/columns it sees (a view sees only a
@@ -92,19 +84,23 @@ class _View:
     ok: np.ndarray   # crop pixels this view sees
     r0: int = 0      # the crop's first row / column in the grid
     c0: int = 0
+    edge_px: np.ndarray | None = None  # crop pixels' distance in the colour image to the nearest depth jump (px)
 
     @staticmethod
-    def cropped(frame: int, xn: np.ndarray, ok: np.ndarray, r_off: int = 0, c_off: int = 0) -> "_View":
+    def cropped(frame: int, xn: np.ndarray, ok: np.ndarray, r_off: int = 0, c_off: int = 0,
+                edge_px: np.ndarray | None = None) -> "_View":
         """The view cut to the bounding box of ``ok``; (``r_off``, ``c_off``): where ``xn``/``ok`` start in the grid."""
         rows, cols = np.flatnonzero(ok.any(1)), np.flatnonzero(ok.any(0))
         r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
         return _View(frame, np.ascontiguousarray(xn[r0:r1, c0:c1]), np.ascontiguousarray(ok[r0:r1, c0:c1]),
-                     int(r0) + r_off, int(c0) + c_off)
+                     int(r0) + r_off, int(c0) + c_off,
+                     None if edge_px is None else np.ascontiguousarray(edge_px[r0:r1, c0:c1]))
 
     def every_other(self) -> "_View":
         """The view on the grid's every other row and column (grid pixels with even indices)."""
         lr, lc = self.r0 % 2, self.c0 % 2
-        return _View(self.frame, self.xn[lr::2, lc::2], self.ok[lr::2, lc::2], (self.r0 + lr) // 2, (self.c0 + lc) // 2)
+        return _View(self.frame, self.xn[lr::2, lc::2], self.ok[lr::2, lc::2], (self.r0 + lr) // 2, (self.c0 + lc) // 2,
+                     None if self.edge_px is None else self.edge_px[lr::2, lc::2])
 
     def paste(self, crop: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
         """``crop`` (h, w[, C]) placed in a NaN grid of ``shape``."""
@@ -123,10 +119,11 @@ def _grid(plane: Plane, res: float, margin: float) -> tuple[np.ndarray, float, f
 
 def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: Rasterizer, n_faces: int,
                       read_rgb: Callable[[Frame], np.ndarray], params: OrthoParams = OrthoParams()
-                      ) -> tuple[list[Orthophoto], ColourCalibration]:
-    """Fused orthophoto of each plane and the colour calibration used (see module docstring)."""
+                      ) -> tuple[list[Orthophoto], ColourCalibration, dict[int, ColourCalibration]]:
+    """Fused orthophoto of each plane, the scene's colour calibration and each registered view's own
+    correction by frame index (see module docstring)."""
     if not planes or not frames:
-        return [], ColourCalibration()
+        return [], ColourCalibration(), {}
     grids = []
     for p in planes:
         span = max(p.extent_u[1] - p.extent_u[0], p.extent_v[1] - p.extent_v[0]) + 2 * params.margin
@@ -143,6 +140,7 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         rw, rh = max(1, round(intr.width * params.render_scale)), max(1, round(intr.height * params.render_scale))
         depth = raster.render(intr.scaled(rw, rh).K, f.c2w, rw, rh).depth
         usable = _away_from_edges(depth, params.erode_px, params.edge_jump)
+        edge_dist = _edge_distance(depth, params.edge_jump) / params.render_scale  # in colour-image px
         w2c = f.w2c.astype(np.float32)
         K = intr.K
         for i in which:
@@ -156,14 +154,17 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             # the view sees the plane point when the scan surface there is at the plane's depth
             ok = inside & usable[ry, rx] & (np.abs(depth[ry, rx] - z) < params.depth_tol + 0.01 * np.abs(z))
             if ok.sum() >= 50:
-                views[i].append(_View.cropped(fi, xn, ok, r0, c0))
+                views[i].append(_View.cropped(fi, xn, ok, r0, c0, edge_dist[ry, rx]))
         if any(v and v[-1].frame == fi for v in views):
             images[fi] = read_rgb(f)
     calib = _calibrate(views, frames, images, params) if params.calibrate else ColourCalibration()
+    per_view = register_views(*_half_grid_points(views, [g[0].shape[:2] for g in grids]), frames, images, calib,
+                              params.register) if params.calibrate else {}
     out = []
     for i, p in enumerate(planes):
         pts, u0, v_top, res = grids[i]
-        stack = [v.paste(_sample(images[v.frame], frames[v.frame], v, calib), pts.shape[:2]) for v in views[i]]
+        stack = [v.paste(_sample(images[v.frame], frames[v.frame], v, per_view.get(v.frame, calib)), pts.shape[:2])
+                 for v in views[i]]
         if stack:
             st = np.stack(stack)
             n = np.isfinite(st[..., 0]).sum(0)
@@ -173,7 +174,24 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             n, color = np.zeros(pts.shape[:2], np.int32), np.zeros(pts.shape[:2] + (3,), np.float32)
             spread = np.zeros(pts.shape[:2], np.float32)
         out.append(Orthophoto(p, color, n.astype(np.int32), u0, v_top, res, spread))
-    return out, calib
+    return out, calib, per_view
+
+
+def _half_grid_points(views: list[list[_View]], shapes: list[tuple[int, int]]) -> tuple[list[list[_Points]], list[int]]:
+    """Every view's seen points on every other pixel of its plane's grid, and those grids' sizes."""
+    out, sizes = [], []
+    for vs, (h, w) in zip(views, shapes):
+        w2 = (w + 1) // 2
+        pts = []
+        for v in vs:
+            s = v.every_other()
+            rr, cc = np.nonzero(s.ok)
+            if len(rr):
+                pts.append(_Points(v.frame, (rr + s.r0) * w2 + cc + s.c0, s.xn[rr, cc],
+                                   None if s.edge_px is None else s.edge_px[rr, cc]))
+        out.append(pts)
+        sizes.append(((h + 1) // 2) * w2)
+    return out, sizes
 
 
 def _project(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int, height: int
@@ -203,16 +221,6 @@ def _window_in_view(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int,
             max(0, (cols[0] - 1) * step), min(W, (cols[-1] + 1) * step + 1))
 
 
-def _pixel_coords(xn: np.ndarray, f: Frame, W: int, H: int, c: ColourCalibration) -> tuple[np.ndarray, np.ndarray]:
-    """Pixel coords in ``f``'s colour image of size W x H of normalised coords ``xn`` (..., 2), under
-    calibration ``c`` (its shift is in px at 640 px width)."""
-    intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
-    s = W / 640.0
-    x = (c.scale * intr.fx * xn[..., 0] + intr.cx + c.dx * s).astype(np.float32)
-    y = (c.scale * intr.fy * xn[..., 1] + intr.cy + c.dy * s).astype(np.float32)
-    return x, y
-
-
 def _sample(img: np.ndarray, f: Frame, v: _View, c: ColourCalibration, gray: bool = False) -> np.ndarray:
     """The view's colours on its crop of the grid (NaN where unseen), exposure-normalised, under
     calibration ``c``. Only the image window the samples fall in is converted and read."""
@@ -235,27 +243,6 @@ def _sample(img: np.ndarray, f: Frame, v: _View, c: ColourCalibration, gray: boo
     col = col / max(float(col[inside].mean()), 1.0)
     col[~inside] = np.nan
     return col
-
-
-@dataclass
-class _Points:
-    """One view's seen points of a calibration grid, flattened: grid index and normalised image coords."""
-
-    frame: int
-    idx: np.ndarray  # (N,) flat index into the calibration grid
-    xn: np.ndarray   # (N, 2) float32
-
-
-def _remap_points(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Bilinear samples of ``img`` at (x, y) with cv2.remap's own arithmetic (maps laid out in rows of
-    1024: remap's maps must stay under 32767 a side)."""
-    n = len(x)
-    m = -(-n // 1024) * 1024
-    mx, my = np.full(m, -1, np.float32), np.full(m, -1, np.float32)
-    mx[:n], my[:n] = x, y
-    out = cv2.remap(img, mx.reshape(-1, 1024), my.reshape(-1, 1024), cv2.INTER_LINEAR,
-                    borderMode=cv2.BORDER_CONSTANT, borderValue=0)
-    return out.reshape(-1)[:n]
 
 
 def _disagreement(views: list[_Points], frames: Sequence[Frame], gray: dict[int, np.ndarray], c: ColourCalibration,
@@ -334,24 +321,14 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
     return ColourCalibration(best.scale, best.dx, best.dy, base, best_cost)
 
 
-def _nanmedian(stack: np.ndarray) -> np.ndarray:
-    """Per-pixel median over views (axis 0) ignoring NaN, 0 where no view. Sort-based, one channel
-    at a time (numpy's nanmedian is ~10x slower and copies the whole stack)."""
-    out = np.zeros(stack.shape[1:], np.float32)
-    chans = [None] if stack.ndim == 3 else range(stack.shape[-1])
-    for c in chans:
-        a = stack if c is None else stack[..., c]
-        a = np.where(np.isfinite(a), a, np.inf).astype(np.float32)
-        a.sort(axis=0)
-        n = np.isfinite(a).sum(0)
-        lo = np.take_along_axis(a, np.maximum((n - 1) // 2, 0)[None], 0)[0]
-        hi = np.take_along_axis(a, np.maximum(n // 2, 0)[None], 0)[0]
-        med = np.where(n > 0, 0.5 * (lo + hi), 0.0)
-        if c is None:
-            out = med.astype(np.float32)
-        else:
-            out[..., c] = med
-    return out
+def _edge_distance(depth: np.ndarray, jump: float) -> np.ndarray:
+    """Per pixel, the distance (px) to the nearest depth jump over ``jump`` or miss: how far a blur may
+    reach before it mixes in a surface at another depth (whose place in the image moves with the view)."""
+    d = np.where(depth > 0, depth, 0.0).astype(np.float32)
+    k = np.ones((3, 3), np.uint8)
+    edge = ((cv2.dilate(d, k) - cv2.erode(d, k)) > jump) | (d <= 0)
+    dist = cv2.distanceTransform((~edge).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
+    return np.minimum(dist, float(max(depth.shape)))  # no jump at all: the image's size, not FLT_MAX
 
 
 def _away_from_edges(depth: np.ndarray, px: int, jump: float) -> np.ndarray:

@@ -14,9 +14,10 @@ from react3d_core.data.mesh import TriMesh
 from react3d_core.perception.heuristic.facets import planar_facets
 from react3d_core.perception.heuristic.front_cells import CellParams, find_handles, split_cells
 from react3d_core.perception.heuristic.fronts import find_fronts
-from react3d_core.perception.heuristic.image_fronts import find_image_fronts
+from react3d_core.perception.heuristic.image_fronts import ImageFrontParams, find_image_fronts
 from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, OrthoParams, _nanmedian
 from react3d_core.perception.heuristic.planes import Plane, vertical_planes
+from react3d_core.perception.heuristic.view_registration import RegistrationParams
 from react3d_core.raster import Rasterizer
 from react3d_core.synthetic.render import RayCaster
 
@@ -110,11 +111,13 @@ def test_find_fronts_no_candidate_gives_no_front() -> None:
     assert find_fronts(floor, facets, np.ones(facets.n, bool), np.array([0.5, 0.5, 1.5])) == []
 
 
-def _seamless_cabinet_scene(scale: float = 1.0, shift_px: tuple[float, float] = (0.0, 0.0)):  # noqa: ANN202
+def _seamless_cabinet_scene(scale: float = 1.0, shift_px: tuple[float, float] = (0.0, 0.0),
+                            per_view: list[tuple[float, float, float]] | None = None):  # noqa: ANN202
     """A 1.2 x 0.7 m flat run of two doors, no seam in the mesh: the gap and the handles exist only in
     the vertex colours (like a TSDF scan, where the photos show what the mesh lost). Rendered from five
     views; colour images may be rendered with a focal ``scale`` and a principal-point shift (an
-    unregistered colour camera)."""
+    unregistered colour camera), and each view with its own further (scale, dx, dy) in ``per_view``
+    (colour not synchronised with depth)."""
     def paint(x: np.ndarray, z: np.ndarray) -> np.ndarray:
         c = np.tile(np.array([170, 40, 40], np.uint8), (len(x), 1))
         c[np.abs(x - 0.6) < 0.006] = (60, 20, 20)                                  # the seam
@@ -136,7 +139,13 @@ def _seamless_cabinet_scene(scale: float = 1.0, shift_px: tuple[float, float] = 
     for i, ex in enumerate((-0.3, 0.1, 0.6, 1.1, 1.5)):
         c2w = look_at(np.array([ex, -1.6, 1.0]), np.array([0.6, 0.0, 0.45]))
         fid = f"frame_{i:06d}"
-        images[fid] = caster.rgb(caster.cast(Kc, c2w, W, H), rng)
+        Kv = Kc.copy()
+        if per_view is not None:
+            s_i, dx_i, dy_i = per_view[i]
+            Kv[:2, :2] *= s_i
+            Kv[0, 2] += dx_i
+            Kv[1, 2] += dy_i
+        images[fid] = caster.rgb(caster.cast(Kv, c2w, W, H), rng)
         frames.append(Frame(frame_id=fid, rgb=ImageRef(path=Path(f"{fid}.png"), kind="png"),
                             intrinsics=Intrinsics.from_K(K, W, H), pose=c2w))
     return mesh, frames, images
@@ -162,6 +171,51 @@ def test_seamless_mesh_splits_into_two_doors_from_the_images(scale: float, shift
         assert res.calibration.scale == pytest.approx(scale, abs=0.03)
     else:
         assert res.calibration == ColourCalibration(before=res.calibration.before, after=res.calibration.after)
+
+
+def _registration_errors(res, per_view: list[tuple[float, float, float]], W: int = 480, H: int = 360) -> np.ndarray:  # noqa: ANN001
+    """Per view, px error of where its correction maps three pose-projection pixels against where the
+    renderer put them, less the error common to all views (the consensus may sit anywhere the scene
+    calibration leaves it)."""
+    k = W / 640.0
+    errs = []
+    for i, (s, dx, dy) in enumerate(per_view):
+        c = res.registration.get(i, res.calibration)
+        e = []
+        for u, v in ((100, 80), (240, 180), (380, 280)):
+            want = (s * (u - W / 2) + W / 2 + dx, s * (v - H / 2) + H / 2 + dy)
+            got = (c.scale * (u - W / 2) + W / 2 + c.dx * k, c.scale * (v - H / 2) + H / 2 + c.dy * k)
+            e.append(np.subtract(got, want))
+        errs.append(e)
+    errs = np.array(errs)  # (views, points, 2)
+    return np.linalg.norm(errs - errs.mean(0, keepdims=True), axis=-1).max(1)
+
+
+_REGISTER = ImageFrontParams(ortho=OrthoParams(register=RegistrationParams(sigmas_px=(12.0, 6.0, 3.0, 1.5))))
+
+
+def test_each_view_is_registered_onto_the_others() -> None:
+    """Colour not synchronised with depth: each view's colour is off by its own scale and shift (up to
+    6 px). The per-view registration brings every view within a pixel of the others, and the doors are
+    still split; with registration off the views stay several pixels apart (the check can fail)."""
+    per_view = [(1.0, 0.0, 0.0), (0.97, 5.0, -3.0), (1.03, -6.0, 2.0), (1.0, 3.0, 6.0), (0.98, -4.0, -5.0)]
+    mesh, frames, images = _seamless_cabinet_scene(per_view=per_view)
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], params=_REGISTER)
+    assert sorted(res.registration) == list(range(5))
+    err = _registration_errors(res, per_view)
+    assert err.max() < 0.6, err
+    assert len(res.fronts) == 2
+    res_off = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id])  # the default: off
+    assert _registration_errors(res_off, per_view).max() > 4.0
+
+
+def test_registration_leaves_registered_colour_alone() -> None:
+    """Views that already agree end where they started (within a tenth of a pixel)."""
+    mesh, frames, images = _seamless_cabinet_scene()
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], params=_REGISTER)
+    assert _registration_errors(res, [(1.0, 0.0, 0.0)] * 5).max() < 0.1
+    for c in res.registration.values():
+        assert abs(c.scale - 1) < 1e-3 and abs(c.dx) < 0.2 and abs(c.dy) < 0.2
 
 
 def test_orthophoto_params_are_in_the_config() -> None:
