@@ -26,19 +26,23 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
+from ...config.perception import HeuristicConfig
 from ...data.frames import Frame
 from .colour_sampling import ColourCalibration, Points, nanmedian, pixel_coords, remap_points
+
+
+_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic.register_*)
 
 
 @dataclass(frozen=True)
 class RegistrationParams:
     """Per-view registration parameters (built from ``HeuristicConfig.register_*``)."""
 
-    sigmas_px: tuple[float, ...] = ()  # blur per level, px at 640 px width, e.g. (12, 6, 3, 1.5); () = off
+    sigmas_px: tuple[float, ...] = tuple(_H.register_sigmas_px)  # blur per level, px at 640 px width; () = off
     rounds: int = 2                  # per level: re-fuse the median, then ``iters`` Gauss-Newton steps per view
     iters: int = 3
-    prior_scale: float = 0.08        # prior std of a view's focal scale around the scene calibration
-    prior_shift_px: float = 30.0     # prior std of its shift (px at 640 px width)
+    prior_scale: float = _H.register_prior_scale  # prior std of a view's focal scale around the scene calibration
+    prior_shift_px: float = _H.register_prior_shift_px  # prior std of its shift (px at 640 px width)
     min_views: int = 3               # a grid pixel takes part when this many views see it
     min_points: int = 2000           # a view with fewer such pixels keeps the scene calibration (8 mm grid: ~0.13 m²)
     band: float = 2.0                # signal: log brightness blurred at sigma less blurred at band * sigma (0: less the plane mean)
