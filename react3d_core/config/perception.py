@@ -115,7 +115,7 @@ class HeuristicConfig(StageConfig):
     calib_scale_range: tuple[float, float] = Field((0.84, 1.12), description="Colour calibration: focal scales searched.")
     calib_shift_range_px: float = Field(16.0, ge=0, description="Colour calibration: principal-point shifts searched (px at 640 px width).")
     calib_min_gain: float = Field(0.2, ge=0, le=1, description="Colour calibration: used only when it cuts the disagreement by this fraction.")
-    register_sigmas_px: tuple[float, ...] = Field((12.0, 6.0, 3.0, 1.5), description="Per-view colour registration: image blur per coarse-to-fine level (px at 640 px width); () turns it off.")
+    register_sigmas_px: tuple[float, ...] = Field((), description="Per-view colour registration, opt-in: image blur per coarse-to-fine level (px at 640 px width), e.g. [12, 6, 3, 1.5]; () = off. For RGB-D whose colour is not synchronised with depth (docs/perception.md: what it gains and costs).")
     register_prior_scale: float = Field(0.08, gt=0, description="Per-view colour registration: prior std of a view's focal scale and aspect around the scene calibration.")
     register_prior_shift_px: float = Field(30.0, gt=0, description="Per-view colour registration: prior std of a view's shift (px at 640 px width).")
     min_front_side: float = Field(0.1, ge=0, description="Image cells: no cell narrower than this (m).")

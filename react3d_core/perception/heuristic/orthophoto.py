@@ -10,7 +10,9 @@ views and drop out).
 Colour and depth are often not registered (7-Scenes: uncalibrated Kinect colour camera, so the
 stated focal length is ~10 % off): before fusing, the colour intrinsics are self-calibrated per scene
 — a focal scale and a principal-point shift — by minimising the disagreement between views on the
-largest planes. A scan whose colour is registered keeps scale 1, shift 0.
+largest planes. A scan whose colour is registered keeps scale 1, shift 0. Then each view gets its own
+correction on top (``view_registration``): colour that is not synchronised with depth is off by a
+different amount in every frame.
 """
 
 from __future__ import annotations

@@ -191,26 +191,28 @@ def _registration_errors(res, per_view: list[tuple[float, float, float]], W: int
     return np.linalg.norm(errs - errs.mean(0, keepdims=True), axis=-1).max(1)
 
 
+_REGISTER = ImageFrontParams(ortho=OrthoParams(register=RegistrationParams(sigmas_px=(12.0, 6.0, 3.0, 1.5))))
+
+
 def test_each_view_is_registered_onto_the_others() -> None:
     """Colour not synchronised with depth: each view's colour is off by its own scale and shift (up to
     6 px). The per-view registration brings every view within a pixel of the others, and the doors are
     still split; with registration off the views stay several pixels apart (the check can fail)."""
     per_view = [(1.0, 0.0, 0.0), (0.97, 5.0, -3.0), (1.03, -6.0, 2.0), (1.0, 3.0, 6.0), (0.98, -4.0, -5.0)]
     mesh, frames, images = _seamless_cabinet_scene(per_view=per_view)
-    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id])
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], params=_REGISTER)
     assert sorted(res.registration) == list(range(5))
     err = _registration_errors(res, per_view)
     assert err.max() < 0.6, err
     assert len(res.fronts) == 2
-    off = ImageFrontParams(ortho=OrthoParams(register=RegistrationParams(sigmas_px=())))
-    res_off = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], params=off)
+    res_off = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id])  # the default: off
     assert _registration_errors(res_off, per_view).max() > 4.0
 
 
 def test_registration_leaves_registered_colour_alone() -> None:
     """Views that already agree end where they started (within a tenth of a pixel)."""
     mesh, frames, images = _seamless_cabinet_scene()
-    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id])
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], params=_REGISTER)
     assert _registration_errors(res, [(1.0, 0.0, 0.0)] * 5).max() < 0.1
     for c in res.registration.values():
         assert abs(c.scale - 1) < 1e-3 and abs(c.dx) < 0.2 and abs(c.dy) < 0.2
