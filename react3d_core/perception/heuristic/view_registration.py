@@ -9,13 +9,17 @@ survive depends on which frames were picked.
 
 How: every view gets its own correction of the colour intrinsics (focal scale and principal-point
 shift; ``ColourCalibration``). Starting from the scene calibration, each view is moved onto the
-per-pixel median of all views (exposure-normalised grey, on every other orthophoto pixel) by
-Gauss-Newton steps, coarse to fine: the images are blurred at decreasing sigmas so that large offsets
-are caught first and the median sharpens as the views come together. Huber weights keep specular
-highlights (which move between views) from pulling; a Gaussian prior towards the scene calibration
-holds what a view's texture does not determine (a plane with only vertical lines says nothing about
-the vertical shift). A view whose disagreement does not drop keeps its previous correction. A scan
-whose colour is registered ends where it started (its views already agree).
+per-pixel median of all views (on every other orthophoto pixel) by Gauss-Newton steps, coarse to
+fine: the images are blurred at decreasing sigmas so that large offsets are caught first and the
+median sharpens as the views come together. The signal is band-passed log brightness (exposure is an
+offset in log; the band-pass drops smooth shading, which differs between views), and points whose blur
+reaches a depth jump are left out (the surface behind an outline moves with the view). Huber weights
+keep specular highlights from pulling; a Gaussian prior towards the scene calibration, with the data
+counted per blur-sized cell, holds what a view's texture does not determine (a plane with only
+vertical lines says nothing about the vertical shift). After every round the corrections lose their
+median drift, and at the end a view keeps its correction only when it fits clearly better than the
+scene calibration. A scan whose colour is registered ends where it started (its views already agree).
+Opt-in (``register_sigmas_px``); docs/perception.md has what it gains and costs.
 """
 
 from __future__ import annotations
@@ -58,7 +62,7 @@ class _Seen:
     idx: np.ndarray    # (N,) int64 flat index into the plane's sub-sampled grid
     xn: np.ndarray     # (N, 2) float32
     edge_px: np.ndarray  # (N,) distance to the nearest depth jump in the image (px)
-    segments: np.ndarray  # (P,) plane ids present, for per-plane exposure normalisation
+    segments: np.ndarray  # (P,) plane ids present
 
 
 def register_views(planes_points: Sequence[Sequence[Points]], grid_sizes: Sequence[int], frames: Sequence[Frame],
@@ -174,8 +178,8 @@ def _less_plane_means(val: np.ndarray, plane: np.ndarray) -> np.ndarray:
 def _medians(seen: dict[int, _Seen], frames: Sequence[Frame], imgs: dict[int, np.ndarray],
              cur: dict[int, ColourCalibration], grid_sizes: Sequence[int], min_views: int,
              lv: tuple[float, bool]) -> list[np.ndarray]:
-    """Per plane, the median over views of the normalised brightness per grid pixel (NaN where fewer
-    than ``min_views`` views)."""
+    """Per plane, the median over views of the signal per grid pixel (NaN where fewer than
+    ``min_views`` views)."""
     per_plane: list[list[tuple[np.ndarray, np.ndarray]]] = [[] for _ in grid_sizes]
     for f, pts in seen.items():
         val = _sample(pts, frames[f], imgs[f], cur[f], lv)[0]
