@@ -1,11 +1,12 @@
 """What the image path of the heuristic costs per frame: the heuristic built with and without it.
 
-    python3 benchmarks/bench_image_fronts.py [SCENE ...] [--stride 5] [--json benchmarks/results/image_fronts_cost.json]
+    python3 benchmarks/bench_image_fronts.py [SCENE ...] [--stride 5] [--register] [--json benchmarks/results/image_fronts_cost.json]
 
 Without SCENE it measures a synthetic TSDF kitchen (960x720 photo frames, made in a temporary
 folder) and, when present, the real RedKitchen scan (640x480). Each scene is built twice in one
 process (mesh-only heuristic, then mesh + images) after a warm-up read of the frames; the added cost
-per frame is (t_image - t_mesh) / frames. Prints a table and writes JSON.
+per frame is (t_image - t_mesh) / frames. ``--register`` measures the image path with the opt-in
+per-view colour registration on (``register_sigmas_px`` 12, 6, 3, 1.5). Prints a table and writes JSON.
 """
 
 from __future__ import annotations
@@ -22,10 +23,15 @@ sys.path.insert(0, str(ROOT))
 REDKITCHEN = ROOT.parent / "shared" / "data" / "redkitchen"
 
 
-def measure(scene_dir: Path, stride: int) -> dict:
+REGISTER_SIGMAS = (12.0, 6.0, 3.0, 1.5)
+
+
+def measure(scene_dir: Path, stride: int, register: bool = False) -> dict:
     from react3d_core.config import FrameSelectionConfig
     from react3d_core.perception.heuristic import HeuristicModel
     from react3d_core.perception.heuristic.image_fronts import ImageFrontParams
+    from react3d_core.perception.heuristic.orthophoto import OrthoParams
+    from react3d_core.perception.heuristic.view_registration import RegistrationParams
     from react3d_core.scene_io import load_scene
     from react3d_core.scene_io.images import frame_rgb
 
@@ -35,7 +41,9 @@ def measure(scene_dir: Path, stride: int) -> dict:
     t0 = time.perf_counter()
     mesh_only = HeuristicModel(scene, image=None)
     t1 = time.perf_counter()
-    both = HeuristicModel(scene, image=ImageFrontParams())
+    params = ImageFrontParams(ortho=OrthoParams(register=RegistrationParams(sigmas_px=REGISTER_SIGMAS))) if register \
+        else ImageFrontParams()
+    both = HeuristicModel(scene, image=params)
     t2 = time.perf_counter()
     n = len(scene.frames)
     w, h = scene.frames[0].intrinsics.width, scene.frames[0].intrinsics.height
@@ -44,13 +52,15 @@ def measure(scene_dir: Path, stride: int) -> dict:
             "added_s_per_frame": round((t2 - t1 - (t1 - t0)) / max(n, 1), 3),
             "fronts_mesh_only": len(mesh_only.fronts), "fronts_with_images": len(both.fronts),
             "planes": len(both.image.planes) if both.image else 0,
-            "colour_scale": round(float(both.image.calibration.scale), 3) if both.image else None}
+            "colour_scale": round(float(both.image.calibration.scale), 3) if both.image else None,
+            "per_view_registration": register}
 
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scenes", nargs="*", type=Path)
     ap.add_argument("--stride", type=int, default=5)
+    ap.add_argument("--register", action="store_true", help="Image path with the opt-in per-view colour registration.")
     ap.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "results" / "image_fronts_cost.json")
     args = ap.parse_args()
     import os
@@ -64,12 +74,12 @@ def main() -> int:
         scenes.append(generate_scene(Path(tmp.name) / "kitchen_tsdf", seed=0, kind="kitchen", n_frames=60, mesh="tsdf"))
         if REDKITCHEN.is_dir():
             scenes.append(REDKITCHEN)
-    rows = [measure(s, args.stride) for s in scenes]
+    rows = [measure(s, args.stride, args.register) for s in scenes]
     print(f"{'scene':32} {'frames':>6} {'size':>8} {'faces':>8} {'mesh s':>7} {'+img s':>7} {'s/frame':>8} {'fronts':>9}")
     for r in rows:
         print(f"{Path(r['scene']).name[:32]:32} {r['frames']:6d} {r['size']:>8} {r['faces']:8d} {r['mesh_only_s']:7.2f} "
               f"{r['with_images_s']:7.2f} {r['added_s_per_frame']:8.3f} {r['fronts_mesh_only']:4d}->{r['fronts_with_images']:<4d}")
-    out = {"cores": os.cpu_count(), "stride": args.stride, "rows": rows}
+    out = {"cores": os.cpu_count(), "stride": args.stride, "per_view_registration": args.register, "rows": rows}
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(out, indent=2))
     print(f"wrote {args.json}")
