@@ -132,6 +132,7 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         res = max(params.resolution, span / params.max_side_px)
         grids.append((*_grid(p, res, params.margin), res))
     picks = _pick_views(planes, frames, [g[0] for g in grids], params.min_cos, params.max_views)
+    register = params.calibrate and bool(params.register.sigmas_px)
     views: list[list[_View]] = [[] for _ in planes]
     images: dict[int, np.ndarray] = {}
     for fi, f in enumerate(frames):
@@ -142,7 +143,8 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         rw, rh = max(1, round(intr.width * params.render_scale)), max(1, round(intr.height * params.render_scale))
         depth = raster.render(intr.scaled(rw, rh).K, f.c2w, rw, rh).depth
         usable = _away_from_edges(depth, params.erode_px, params.edge_jump)
-        edge_dist = _edge_distance(depth, params.edge_jump) / params.render_scale  # in colour-image px
+        # in colour-image px; only the per-view registration reads it
+        edge_dist = _edge_distance(depth, params.edge_jump) / params.render_scale if register else None
         w2c = f.w2c.astype(np.float32)
         K = intr.K
         for i in which:
@@ -156,12 +158,12 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             # the view sees the plane point when the scan surface there is at the plane's depth
             ok = inside & usable[ry, rx] & (np.abs(depth[ry, rx] - z) < params.depth_tol + 0.01 * np.abs(z))
             if ok.sum() >= 50:
-                views[i].append(_View.cropped(fi, xn, ok, r0, c0, edge_dist[ry, rx]))
+                views[i].append(_View.cropped(fi, xn, ok, r0, c0, None if edge_dist is None else edge_dist[ry, rx]))
         if any(v and v[-1].frame == fi for v in views):
             images[fi] = read_rgb(f)
     calib = _calibrate(views, frames, images, params) if params.calibrate else ColourCalibration()
     per_view = register_views(*_half_grid_points(views, [g[0].shape[:2] for g in grids]), frames, images, calib,
-                              params.register) if params.calibrate else {}
+                              params.register) if register else {}
     out = []
     for i, p in enumerate(planes):
         pts, u0, v_top, res = grids[i]
