@@ -106,11 +106,19 @@ def _clearly_better(pts: "_Seen", f: Frame, img: np.ndarray, refs: list[np.ndarr
     target = _targets(pts, refs)
     a, ok_a = _sample(pts, f, img, c, lv)[:2]
     b, ok_b = _sample(pts, f, img, base, lv)[:2]
-    both = np.isfinite(target) & ok_a & ok_b
-    if both.sum() < p.min_points:
-        return False
-    s = _mad_scale(b[both] - target[both])
-    return _huber(a[both] - target[both], s)[0] < (1 - p.min_gain) * _huber(b[both] - target[both], s)[0]
+    costs = _costs(a, ok_a, b, ok_b, target, p.min_points)
+    return costs is not None and costs[0] < (1 - p.min_gain) * costs[1]
+
+
+def _costs(new: np.ndarray, ok_new: np.ndarray, old: np.ndarray, ok_old: np.ndarray, target: np.ndarray,
+           min_points: int) -> tuple[float, float] | None:
+    """Robust costs (new, old) against ``target`` on the points both see, at the old residuals' scale;
+    None when fewer than ``min_points`` are seen by both."""
+    both = np.isfinite(target) & ok_new & ok_old
+    if both.sum() < min_points:
+        return None
+    s = _mad_scale(old[both] - target[both])
+    return _huber(new[both] - target[both], s)[0], _huber(old[both] - target[both], s)[0]
 
 
 def _targets(pts: "_Seen", refs: list[np.ndarray]) -> np.ndarray:
@@ -276,11 +284,5 @@ def _gauss_newton(pts: _Seen, f: Frame, img: np.ndarray, grads: tuple[np.ndarray
             return c
         if np.abs(step[1:]).max() < 0.05 and abs(step[0]) < 1e-4:
             break
-    new = _with(c, th)
-    both = start_ok & ok
-    if both.sum() < p.min_points:
-        return c
-    s = _mad_scale(start_val[both] - target[both])
-    before = _huber(start_val[both] - target[both], s)[0]
-    after = _huber(val[both] - target[both], s)[0]
-    return new if after < before else c
+    costs = _costs(val, ok, start_val, start_ok, target, p.min_points)
+    return _with(c, th) if costs is not None and costs[0] < costs[1] else c
