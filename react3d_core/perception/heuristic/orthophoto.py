@@ -142,9 +142,10 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         intr = f.intrinsics
         rw, rh = max(1, round(intr.width * params.render_scale)), max(1, round(intr.height * params.render_scale))
         depth = raster.render(intr.scaled(rw, rh).K, f.c2w, rw, rh).depth
-        usable = _away_from_edges(depth, params.erode_px, params.edge_jump)
+        edges = _depth_edges(depth, params.edge_jump)
+        usable = _away_from_edges(depth, params.erode_px, params.edge_jump, edges)
         # in colour-image px; only the per-view registration reads it
-        edge_dist = _edge_distance(depth, params.edge_jump) / params.render_scale if register else None
+        edge_dist = _edge_distance(depth, params.edge_jump, edges) / params.render_scale if register else None
         w2c = f.w2c.astype(np.float32)
         K = intr.K
         for i in which:
@@ -325,21 +326,26 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
     return ColourCalibration(best.scale, best.dx, best.dy, base, best_cost)
 
 
-def _edge_distance(depth: np.ndarray, jump: float) -> np.ndarray:
-    """Per pixel, the distance (px) to the nearest depth jump over ``jump`` or miss: how far a blur may
-    reach before it mixes in a surface at another depth (whose place in the image moves with the view)."""
+def _depth_edges(depth: np.ndarray, jump: float) -> np.ndarray:
+    """Pixels at a depth jump over ``jump`` (3x3 max - min) or without a surface."""
     d = np.where(depth > 0, depth, 0.0).astype(np.float32)
     k = np.ones((3, 3), np.uint8)
-    edge = ((cv2.dilate(d, k) - cv2.erode(d, k)) > jump) | (d <= 0)
+    return ((cv2.dilate(d, k) - cv2.erode(d, k)) > jump) | (d <= 0)
+
+
+def _edge_distance(depth: np.ndarray, jump: float, edge: np.ndarray | None = None) -> np.ndarray:
+    """Per pixel, the distance (px) to the nearest depth jump over ``jump`` or miss: how far a blur may
+    reach before it mixes in a surface at another depth (whose place in the image moves with the view).
+    ``edge``: those pixels when already found (``_depth_edges``)."""
+    edge = _depth_edges(depth, jump) if edge is None else edge
     dist = cv2.distanceTransform((~edge).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_PRECISE)
     return np.minimum(dist, float(max(depth.shape)))  # no jump at all: the image's size, not FLT_MAX
 
 
-def _away_from_edges(depth: np.ndarray, px: int, jump: float) -> np.ndarray:
-    """Pixels with a surface whose (2px+1)² neighbourhood has no depth jump over ``jump`` and no miss."""
-    d = np.where(depth > 0, depth, 0.0).astype(np.float32)
-    k = np.ones((3, 3), np.uint8)
-    edge = ((cv2.dilate(d, k) - cv2.erode(d, k)) > jump) | (d <= 0)
+def _away_from_edges(depth: np.ndarray, px: int, jump: float, edge: np.ndarray | None = None) -> np.ndarray:
+    """Pixels with a surface whose (2px+1)² neighbourhood has no depth jump over ``jump`` and no miss.
+    ``edge``: those jumps and misses when already found (``_depth_edges``)."""
+    edge = _depth_edges(depth, jump) if edge is None else edge
     if px > 0:
         edge = cv2.dilate(edge.astype(np.uint8), np.ones((2 * px + 1, 2 * px + 1), np.uint8)).astype(bool)
     return ~edge
