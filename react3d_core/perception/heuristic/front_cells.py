@@ -160,15 +160,18 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.nd
     # the plane's own outline (a worktop edge's shadow, the floor line) is no handle: keep 2 cm away
     edge = max(1, int(round(p.outline_margin / o.res)))
     inner = cv2.erode(coverage.astype(np.uint8), np.ones((2 * edge + 1, 2 * edge + 1), np.uint8)).astype(bool)
-    blob = ((diff > thr) & valid & inner).astype(np.uint8)
-    if protrusion is not None:  # a handle that is in the mesh: its footprint in front of the plane
-        blob |= protrusion.astype(np.uint8)
+    colour = ((diff > thr) & valid & inner).astype(np.uint8)
+    # a handle that is in the mesh: its footprint in front of the plane
+    bar = np.zeros_like(colour) if protrusion is None else protrusion.astype(np.uint8)
     # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
+    blob = colour | bar
     L = int(p.handle_len[1] / o.res) + 1
     strips = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((1, L), np.uint8)) | \
         cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
-    blob = blob & ~cv2.dilate(strips, np.ones((3, 3), np.uint8))
-    blob = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8))  # cuts 1-2 px grain bridges
+    keep = 1 - cv2.dilate(strips, np.ones((3, 3), np.uint8))
+    # the opening cuts 1-2 px grain bridges in the colour; a bar in the mesh is no grain and, 3-4 px wide
+    # at 4 mm, would fall apart under it
+    blob = cv2.morphologyEx(colour & keep, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) | (bar & keep)
     g = max(3, int(0.03 / o.res) | 1)  # a bar broken by a highlight is one handle
     blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
     n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=8)

@@ -423,6 +423,37 @@ def test_enclosed_handle_shadows_hand_computed() -> None:
     assert np.array_equal(holes, expected)
 
 
+def test_protrusion_map_grows_the_splat_by_one_pixel() -> None:
+    """One outward face 3 cm in front of the plane (4 mm px) marks the 3 x 3 px around its centroid's
+    pixel; a face 1 cm in front (under the 1.2 cm minimum) or facing away marks nothing."""
+    from react3d_core.perception.heuristic.image_fronts import protrusion_map
+
+    o = _ortho(np.ones((50, 60, 3), np.float32), res=0.004)        # plane y = 0, facing -y; v_top = 0.2
+    cen = np.array([[0.1 + 0.002, -0.03, 0.2 - 0.1 - 0.002],      # pixel (row 25, col 25)
+                    [0.05, -0.01, 0.1], [0.15, -0.03, 0.1]])
+    nrm = np.array([[0.0, -1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 1.0, 0.0]])
+    m = protrusion_map(o, cen, nrm)
+    expected = np.zeros((50, 60), bool)
+    expected[24:27, 24:27] = True
+    assert np.array_equal(m, expected)
+
+
+def test_standing_bar_in_the_mesh_is_a_handle() -> None:
+    """At 4 mm px: a standing bar handle in the mesh, two centroid columns wide (the splat of a 1.5 cm bar
+    of 5 mm faces), 16 cm long, is one vertical handle. Before, the colour's 3 x 3 opening erased it."""
+    from react3d_core.perception.heuristic.image_fronts import protrusion_map
+
+    h, w, res = 150, 200, 0.004
+    o = _ortho(np.ones((h, w, 3), np.float32), res=res)
+    cov = np.ones((h, w), bool)
+    zs = 0.6 - (np.arange(30, 70) + 0.5) * res                     # rows 30-69
+    cen = np.array([[(c + 0.5) * res, -0.03, z] for c in (50, 51) for z in zs])
+    bar = protrusion_map(o, cen, np.tile([0.0, -1.0, 0.0], (len(cen), 1)))
+    hs = find_handles(o, cov, CellParams(), None, bar, cov)
+    assert len(hs) == 1 and not hs[0].horizontal
+    assert hs[0].box == (49, 29, 53, 71)
+
+
 def test_handle_found_from_its_shadow_alone() -> None:
     """A plain front whose bar handle left only an unseen hole (no colour anywhere): with the hole as
     handle evidence find_handles reports one horizontal handle there; without it, none."""
