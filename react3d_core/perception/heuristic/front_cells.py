@@ -163,8 +163,8 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.nd
     colour = ((diff > thr) & valid & inner).astype(np.uint8)
     # a handle that is in the mesh: its footprint in front of the plane
     bar = np.zeros_like(colour) if protrusion is None else protrusion.astype(np.uint8)
-    # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
     blob = colour | bar
+    # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
     L = int(p.handle_len[1] / o.res) + 1
     strips = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((1, L), np.uint8)) | \
         cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
