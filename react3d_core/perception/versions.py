@@ -9,8 +9,10 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 9: a handle-less image front reaching down to the floor is wall (plain_floor_gap);
 # 10: a wide vertical plane's direction is refit from its faces' positions (plane_refit_deg)
 # 11: handles in the mesh skip the colour opening (a 3-4 px bar fell apart) and are grown by 1 px
+# 12: on the room's outer walls (no scan surface behind the plane) only room-door-shaped fronts stay,
+#     typed as side-hinged doors (room_wall)
 # (per-view colour registration, register_sigmas_px, is opt-in: off it changes nothing, and the
 # configuration it runs under is part of the cache key)
-HEURISTIC_VERSION = "11"
+HEURISTIC_VERSION = "12"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -25,6 +25,7 @@ from .facets import planar_facets
 from .fronts import Front, find_fronts
 from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts, params_from_config
 from .sliding import SlidingRules, mark_sliding, sliding_from_config
+from .room_walls import keep_room_doors, room_wall_from_config
 from .splashback import on_worktop, splashback_from_config
 
 log = logging.getLogger("react3d.perception")
@@ -67,6 +68,9 @@ class HeuristicModel:
         worktop = splashback_from_config(h)
         if worktop is not None:  # fronts flush with the wall right above a worktop are splash-back
             self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, worktop)) if not drop]
+        walls = room_wall_from_config(h)
+        if walls is not None:  # on the room's outer walls only room doors open
+            self.fronts = keep_room_doors(self.fronts, self.mesh, walls, rules, self.facets.labels)
         if sliding is not None:
             mark_sliding(self.fronts, sliding)  # two fronts a track apart: sliding doors
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
