@@ -24,8 +24,8 @@ from ...scene_io.images import frame_rgb
 from .facets import planar_facets
 from .fronts import Front, find_fronts
 from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts, params_from_config
-from .sliding import SlidingRules, mark_sliding, sliding_from_config
 from .room_walls import keep_room_doors, room_wall_from_config
+from .sliding import SlidingRules, mark_sliding, sliding_from_config
 from .splashback import on_worktop, splashback_from_config
 
 log = logging.getLogger("react3d.perception")

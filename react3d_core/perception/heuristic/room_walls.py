@@ -84,11 +84,11 @@ def keep_room_doors(fronts: list[Front], mesh: TriMesh, rules: RoomWallRules, fr
     floor = floor_height(mesh, rules.floor_min_area)
     if floor is None:
         floor = float(mesh.vertices[:, 2].min())
-    kept = [f for f, w in zip(fronts, wall) if not w or room_door_shaped(f, floor, rules)]
-    for f, w in zip(fronts, wall):
-        if w and room_door_shaped(f, floor, rules):
-            f.kind, f.articulation = _joint(f, _handle_points(f, mesh, facet_labels), _neighbours(f, kept, front_rules),
-                                            front_rules, side_hinged=True)
+    door = [w and room_door_shaped(f, floor, rules) for f, w in zip(fronts, wall)]
+    kept = [f for f, w, d in zip(fronts, wall, door) if d or not w]
+    for f in (f for f, d in zip(fronts, door) if d):
+        f.kind, f.articulation = _joint(f, _handle_points(f, mesh, facet_labels), _neighbours(f, kept, front_rules),
+                                        front_rules, side_hinged=True)
     return kept
 
 

@@ -6,6 +6,7 @@ import numpy as np
 
 from react3d_core.config.perception import FrontRulesConfig, HeuristicConfig
 from react3d_core.data.mesh import TriMesh
+from react3d_core.geometry import concat_meshes
 from react3d_core.perception.heuristic.fronts import Front
 from react3d_core.perception.heuristic.room_walls import (RoomWallRules, keep_room_doors, on_outer_wall,
                                                           room_wall_from_config)
@@ -23,12 +24,7 @@ def _floor(x0: float, x1: float, y0: float, y1: float) -> tuple[np.ndarray, np.n
 
 
 def _mesh(*quads: tuple[np.ndarray, np.ndarray]) -> TriMesh:
-    vs, fs, off = [], [], 0
-    for v, f in quads:
-        vs.append(v)
-        fs.append(f + off)
-        off += len(v)
-    return TriMesh(np.concatenate(vs), np.concatenate(fs))
+    return TriMesh(*concat_meshes(quads))
 
 
 def _front(x0: float, x1: float, z0: float, z1: float, y: float, faces: list[int] | None = None) -> Front:
