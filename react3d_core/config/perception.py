@@ -96,6 +96,7 @@ class HeuristicConfig(StageConfig):
     room_door_min_h: float = Field(1.8, gt=0, description="Room door on an outer wall: at least this tall (m) ...")
     room_door_w: tuple[float, float] = Field((0.6, 1.3), description="... this wide (min, max; m) ...")
     room_door_floor_gap: float = Field(0.05, ge=0, description="... and its bottom edge this close to the floor (m).")
+    drawer_max_top: float = Field(1.7, ge=0, description="A drawer's top edge is at most this high above the floor (m): nothing slides out above eye level; a drawer-typed strip higher up is dropped (perception/heuristic/reach.py); 0: no limit.")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
     sliding_track_offset: tuple[float, float] = Field((0.008, 0.06), description="Sliding doors: plane offset between two side-by-side fronts on two tracks (m).")
     sliding_max_overlap: float = Field(0.12, ge=0, description="Sliding doors: the two fronts' outlines overlap by at most this (m).")
@@ -135,6 +136,8 @@ class HeuristicConfig(StageConfig):
     handle_shadows: bool = Field(True, description="Image handles: on a front without a seen handle, an enclosed horizontal unseen hole of handle size above the cameras' median height is the handle's scanning shadow (a bar seen from below hides the front behind it in every view); it types the joint (wall-cabinet flaps), it does not cut cells.")
     texture_factor: float = Field(3.0, ge=0, description="Image path: handle/seam thresholds rise to this many times the plane's median response (textured planes).")
     max_split_depth: int = Field(6, ge=0, description="Image cells: guillotine split recursion depth.")
+    cell_tighten: bool = Field(True, description="Image cells: every cell shrinks to the box of the plane's faces in it before it is cut or judged (the region left of a base run under an empty wall is not part of its doors' cells).")
+    outline_step: float = Field(0.5, ge=0, description="Image cells: where the covered extent across a line jumps by this share of the cell (an L-shaped outline: a tall unit beside a base run), the cell is cut there first; 0: off.")
 
 
 class PerceptionConfig(StageConfig):

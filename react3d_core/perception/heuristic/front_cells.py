@@ -49,6 +49,8 @@ class CellParams:
     step_z: float = _H.step_z                    # ... and in noise units of the cell's steps
     max_depth: int = _H.max_split_depth          # guillotine recursion depth
     step_over_dip: bool = _H.step_over_dip       # a colour step stronger than the best dark line is the edge
+    tighten: bool = _H.cell_tighten              # a cell shrinks to its covered box before it is cut or judged
+    outline_step: float = _H.outline_step        # a jump of the covered extent by this share of the cell cuts it first (0: off)
 
 
 @dataclass
@@ -304,6 +306,46 @@ def _dip_cut(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellPara
     return i + min_px, float(inner[i])
 
 
+def _tightened(c: Cell, cov: np.ndarray) -> Cell | None:
+    """``c`` shrunk to the box of its covered pixels (None: it covers none). A cut leaves the part of a
+    run above the worktop, say, in its doors' cells; the box is what the plane's faces fill."""
+    sub = cov[c.r0:c.r1, c.c0:c.c1]
+    rows, cols = np.any(sub, 1), np.any(sub, 0)
+    if not rows.any():
+        return None
+    r = np.flatnonzero(rows)
+    k = np.flatnonzero(cols)
+    return Cell(c.c0 + int(k[0]), c.r0 + int(r[0]), c.c0 + int(k[-1]) + 1, c.r0 + int(r[-1]) + 1,
+                c.handles, c.cut_sides, c.seam_cuts)
+
+
+def _outline_cut(cov: np.ndarray, axis: int, min_px: int, blocked: np.ndarray) -> tuple[int, float]:
+    """Where the cell's covered extent across lines jumps (index in the cell, jump as a share of the
+    cell's extent along ``axis``): the corner of an L-shaped outline, a tall unit beside a base run.
+    The jump is between the medians of the ``min_px`` lines on either side, so a hole narrower than
+    half of that (a handle's scanning shadow, a ragged TSDF edge) is not a corner; it is placed at the
+    steepest single-line change near it. Both sides keep ``min_px`` lines; no cut runs through a handle."""
+    n = cov.sum(axis).astype(float)
+    m = len(n)
+    if m <= 2 * min_px + 1:
+        return -1, 0.0
+    win = np.median(np.lib.stride_tricks.sliding_window_view(n, min_px), axis=1)  # win[i]: lines i .. i + min_px - 1
+    idx = np.arange(min_px, m - min_px)
+    jump = np.abs(win[idx + 1] - win[idx - min_px]) / cov.shape[axis]
+    jump[blocked[idx]] = 0.0
+    i = int(np.argmax(jump))
+    if jump[i] <= 0.0:
+        return -1, 0.0
+    k = max(2, min_px // 2)
+    lo, hi = max(int(idx[i]) - k, min_px), min(int(idx[i]) + k, m - min_px - 1)
+    d = np.abs(np.diff(n))[lo:hi + 1]  # d[j - lo]: change between lines j and j + 1
+    j = lo + int(np.argmax(d))
+    cut = min(j + 1, m - min_px - 1) if n[j + 1] < n[j] else j  # the line dropped is on the emptier side
+    if blocked[cut]:
+        return -1, 0.0
+    return cut, float(jump[i])
+
+
 def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: CellParams, min_px: int,
            depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray,
            col: np.ndarray) -> list[Cell]:
@@ -311,9 +353,25 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
     prominent seam by valley counts. Inside a cell holding handles, a horizontal cut must leave a handle
     on both sides (glossy fronts reflect horizontal table and shelf edges at a constant height; a drawer
     above a door carries its own handle)."""
+    if p.tighten:
+        c = _tightened(c, cov)
+        if c is None:
+            return []  # none of the plane's faces: nothing to open
     if depth >= p.max_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
+    if p.outline_step > 0:  # an L-shaped outline splits at its corner before any seam is sought
+        ov, sv = _outline_cut(cov[sl], 0, min_px, bc[c.c0:c.c1])
+        oh, sh = _outline_cut(cov[sl], 1, min_px, br[c.r0:c.r1])
+        if max(sv, sh) >= p.outline_step:  # columns first: a run splits into units, a unit into fronts
+            if sv >= p.outline_step:
+                a = Cell(c.c0, c.r0, c.c0 + ov, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
+                b = Cell(c.c0 + ov + 1, c.r0, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
+            else:
+                a = Cell(c.c0, c.r0, c.c1, c.r0 + oh, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
+                b = Cell(c.c0, c.r0 + oh + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
+            return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, handles, g, col)
+                    + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, handles, g, col))
     cv_, sc_v = _dip_cut(g[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
     ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
     sc_v = sc_v if sc_v >= p.seam_z else 0.0

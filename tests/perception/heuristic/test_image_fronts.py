@@ -649,3 +649,51 @@ def test_fit_direction_leaves_separate_short_pieces_alone() -> None:
     assert n is nd
     n_joined, _ = fit_direction(xy, np.ones(len(xy)), nd, 3.0, min_extent=0.5)  # allowed, it would turn
     assert abs(np.degrees(np.arctan2(n_joined[1], n_joined[0]))) > 0.2
+
+
+def test_outline_cut_and_tightened_cell_hand_computed() -> None:
+    """An L-shaped outline, 200 x 100 px: columns 0-79 covered on all 100 rows, columns 80-199 on rows
+    60-99 only. Columns: jump (100 - 40) / 100 = 0.6, between columns 79 and 80 -> cut at 80 (the line
+    dropped is on the emptier side). Rows: (200 - 80) / 200 = 0.6 between rows 59 and 60 -> cut at 59.
+    The box of the covered pixels of the right part is columns 81-199, rows 60-99."""
+    from react3d_core.perception.heuristic.front_cells import Cell, _outline_cut, _tightened
+
+    cov = np.zeros((100, 200), bool)
+    cov[:, :80] = True
+    cov[60:, 80:] = True
+    assert _outline_cut(cov, 0, 20, np.zeros(200, bool)) == (80, pytest.approx(0.6))
+    assert _outline_cut(cov, 1, 20, np.zeros(100, bool)) == (59, pytest.approx(0.6))
+    assert _outline_cut(cov, 0, 20, np.arange(200) == 80) == (-1, 0.0)  # a handle on the corner: no cut there
+    assert _outline_cut(np.ones((100, 200), bool), 0, 20, np.zeros(200, bool))[1] == 0.0
+    right = _tightened(Cell(81, 0, 200, 100, cut_sides=1), cov)
+    assert (right.c0, right.r0, right.c1, right.r1, right.cut_sides) == (81, 60, 200, 100, 1)
+    assert _tightened(Cell(81, 0, 200, 50), cov) is None
+
+
+def test_tall_unit_beside_a_base_run_splits_at_its_edge() -> None:
+    """A tall plain unit (0.5 m x 2 m) beside a 1 m base run of two doors (0.7 m high, a seam between
+    them, knob handles) with nothing of the plane above the run: the run's doors come out as cells of
+    their own size (without the outline cut and the tightening, one cell spans the tall unit and the
+    first door, and the second door's cell reaches up into the empty wall and is mostly unseen)."""
+    res = 0.005
+    h, w = 400, 300                                  # 2 m x 1.5 m
+    rng = np.random.default_rng(3)
+    img = np.full((h, w, 3), 0.8, np.float32) + rng.normal(0, 0.01, (h, w, 3)).astype(np.float32)
+    img[:, 100:] = np.array([0.6, 0.7, 0.5], np.float32)  # the run's doors are green; its edge is only a colour step
+    img[260:, 199:201] *= 0.8                        # the seam between the two doors
+    for c0 in (180, 215):                            # a vertical bar handle beside the seam on each door
+        img[280:310, c0:c0 + 4] = 1.6
+    cov = np.zeros((h, w), bool)
+    cov[:, :100] = True
+    cov[260:, 100:] = True                           # the run: 0.7 m high
+    o = _ortho(img, res)
+    o.n_views[~cov] = 0
+    handles = find_handles(o, cov, CellParams())
+    assert len(handles) == 2
+    doors = sorted((c for c in split_cells(o, cov, handles, CellParams()) if c.handles), key=lambda c: c.c0)
+    assert len(doors) == 2
+    assert [abs(d.r0 - 260) <= 2 for d in doors] == [True, True]
+    assert abs(doors[0].c0 - 100) <= 2 and abs(doors[0].c1 - 200) <= 3 and abs(doors[1].c1 - 300) <= 2
+    off = CellParams(tighten=False, outline_step=0.0)
+    old = sorted((c for c in split_cells(o, cov, handles, off) if c.handles), key=lambda c: c.c0)
+    assert any(c.c0 < 90 or c.r0 < 200 for c in old)  # without them a door's cell is not its own
