@@ -136,7 +136,6 @@ class HeuristicConfig(StageConfig):
     handle_shadows: bool = Field(True, description="Image handles: on a front without a seen handle, an enclosed horizontal unseen hole of handle size above the cameras' median height is the handle's scanning shadow (a bar seen from below hides the front behind it in every view); it types the joint (wall-cabinet flaps), it does not cut cells.")
     texture_factor: float = Field(3.0, ge=0, description="Image path: handle/seam thresholds rise to this many times the plane's median response (textured planes).")
     max_split_depth: int = Field(6, ge=0, description="Image cells: guillotine split recursion depth.")
-    cell_tighten: bool = Field(True, description="Image cells: every cell shrinks to the box of the plane's faces in it before it is cut or judged (the region left of a base run under an empty wall is not part of its doors' cells).")
     outline_step: float = Field(0.5, ge=0, description="Image cells: where the covered extent across a line jumps by this share of the cell (an L-shaped outline: a tall unit beside a base run), the cell is cut there first; 0: off.")
 
 

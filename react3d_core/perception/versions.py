@@ -11,8 +11,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 11: handles in the mesh skip the colour opening (a 3-4 px bar fell apart) and are grown by 1 px
 # 12: on the room's outer walls (no scan surface behind the plane) only room-door-shaped fronts stay,
 #     typed as side-hinged doors (room_wall)
-# 13: image cells shrink to their covered box and cut first at an L-shaped outline's corner
-#     (cell_tighten, outline_step); drawer-typed fronts above 1.7 m are dropped (drawer_max_top)
+# 13: image cells are cut first at an L-shaped outline's corner (outline_step); drawer-typed fronts
+#     above 1.7 m are dropped (drawer_max_top)
 # (per-view colour registration, register_sigmas_px, is opt-in: off it changes nothing, and the
 # configuration it runs under is part of the cache key)
 HEURISTIC_VERSION = "13"

@@ -49,7 +49,6 @@ class CellParams:
     step_z: float = _H.step_z                    # ... and in noise units of the cell's steps
     max_depth: int = _H.max_split_depth          # guillotine recursion depth
     step_over_dip: bool = _H.step_over_dip       # a colour step stronger than the best dark line is the edge
-    tighten: bool = _H.cell_tighten              # a cell shrinks to its covered box before it is cut or judged
     outline_step: float = _H.outline_step        # a jump of the covered extent by this share of the cell cuts it first (0: off)
 
 
@@ -306,19 +305,6 @@ def _dip_cut(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellPara
     return i + min_px, float(inner[i])
 
 
-def _tightened(c: Cell, cov: np.ndarray) -> Cell | None:
-    """``c`` shrunk to the box of its covered pixels (None: it covers none). A cut leaves the part of a
-    run above the worktop, say, in its doors' cells; the box is what the plane's faces fill."""
-    sub = cov[c.r0:c.r1, c.c0:c.c1]
-    rows, cols = np.any(sub, 1), np.any(sub, 0)
-    if not rows.any():
-        return None
-    r = np.flatnonzero(rows)
-    k = np.flatnonzero(cols)
-    return Cell(c.c0 + int(k[0]), c.r0 + int(r[0]), c.c0 + int(k[-1]) + 1, c.r0 + int(r[-1]) + 1,
-                c.handles, c.cut_sides, c.seam_cuts)
-
-
 def _outline_cut(cov: np.ndarray, axis: int, min_px: int, blocked: np.ndarray) -> tuple[int, float]:
     """Where the cell's covered extent across lines jumps (index in the cell, jump as a share of the
     cell's extent along ``axis``): the corner of an L-shaped outline, a tall unit beside a base run.
@@ -353,10 +339,6 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
     prominent seam by valley counts. Inside a cell holding handles, a horizontal cut must leave a handle
     on both sides (glossy fronts reflect horizontal table and shelf edges at a constant height; a drawer
     above a door carries its own handle)."""
-    if p.tighten:
-        c = _tightened(c, cov)
-        if c is None:
-            return []  # none of the plane's faces: nothing to open
     if depth >= p.max_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))

@@ -76,7 +76,7 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
                          max_clutter=cfg.max_clutter, max_clutter_handle=cfg.max_clutter_handle, outline_margin=cfg.handle_outline_margin,
                          texture_factor=cfg.texture_factor, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
                          step_z=cfg.step_z, max_depth=cfg.max_split_depth, step_over_dip=cfg.step_over_dip,
-                         tighten=cfg.cell_tighten, outline_step=cfg.outline_step),
+                         outline_step=cfg.outline_step),
         plane_offset_tol=cfg.plane_offset_tol, plane_angle_tol_deg=cfg.plane_angle_tol_deg, plane_refit_deg=cfg.plane_refit_deg,
         plane_refit_min_gain=cfg.plane_refit_min_gain,
         min_plane_area=cfg.min_plane_area, plane_cell=cfg.plane_cell, plane_min_fragment_area=cfg.plane_min_fragment_area,

@@ -651,12 +651,12 @@ def test_fit_direction_leaves_separate_short_pieces_alone() -> None:
     assert abs(np.degrees(np.arctan2(n_joined[1], n_joined[0]))) > 0.2
 
 
-def test_outline_cut_and_tightened_cell_hand_computed() -> None:
+def test_outline_cut_hand_computed() -> None:
     """An L-shaped outline, 200 x 100 px: columns 0-79 covered on all 100 rows, columns 80-199 on rows
     60-99 only. Columns: jump (100 - 40) / 100 = 0.6, between columns 79 and 80 -> cut at 80 (the line
     dropped is on the emptier side). Rows: (200 - 80) / 200 = 0.6 between rows 59 and 60 -> cut at 59.
-    The box of the covered pixels of the right part is columns 81-199, rows 60-99."""
-    from react3d_core.perception.heuristic.front_cells import Cell, _outline_cut, _tightened
+    An 8-row hole (a handle's scanning shadow) is no corner: the medians over 20 rows ignore it."""
+    from react3d_core.perception.heuristic.front_cells import _outline_cut
 
     cov = np.zeros((100, 200), bool)
     cov[:, :80] = True
@@ -665,15 +665,15 @@ def test_outline_cut_and_tightened_cell_hand_computed() -> None:
     assert _outline_cut(cov, 1, 20, np.zeros(100, bool)) == (59, pytest.approx(0.6))
     assert _outline_cut(cov, 0, 20, np.arange(200) == 80) == (-1, 0.0)  # a handle on the corner: no cut there
     assert _outline_cut(np.ones((100, 200), bool), 0, 20, np.zeros(200, bool))[1] == 0.0
-    right = _tightened(Cell(81, 0, 200, 100, cut_sides=1), cov)
-    assert (right.c0, right.r0, right.c1, right.r1, right.cut_sides) == (81, 60, 200, 100, 1)
-    assert _tightened(Cell(81, 0, 200, 50), cov) is None
+    holed = np.ones((100, 200), bool)
+    holed[40:48, 30:150] = False
+    assert _outline_cut(holed, 1, 20, np.zeros(100, bool))[1] == 0.0
 
 
 def test_tall_unit_beside_a_base_run_splits_at_its_edge() -> None:
     """A tall plain unit (0.5 m x 2 m) beside a 1 m base run of two doors (0.7 m high, a seam between
     them, knob handles) with nothing of the plane above the run: the run's doors come out as cells of
-    their own size (without the outline cut and the tightening, one cell spans the tall unit and the
+    their own size (without the outline cut, one cell spans the tall unit and the
     first door, and the second door's cell reaches up into the empty wall and is mostly unseen)."""
     res = 0.005
     h, w = 400, 300                                  # 2 m x 1.5 m
@@ -694,6 +694,6 @@ def test_tall_unit_beside_a_base_run_splits_at_its_edge() -> None:
     assert len(doors) == 2
     assert [abs(d.r0 - 260) <= 2 for d in doors] == [True, True]
     assert abs(doors[0].c0 - 100) <= 2 and abs(doors[0].c1 - 200) <= 3 and abs(doors[1].c1 - 300) <= 2
-    off = CellParams(tighten=False, outline_step=0.0)
+    off = CellParams(outline_step=0.0)
     old = sorted((c for c in split_cells(o, cov, handles, off) if c.handles), key=lambda c: c.c0)
     assert any(c.c0 < 90 or c.r0 < 200 for c in old)  # without them a door's cell is not its own
