@@ -219,6 +219,10 @@ def test_bench_sets_pass_scan_options() -> None:
         assert [e.get("kind") for e in entries] == [e.get("kind") for e in heldout]
     tuning = load_spec("tuning_realistic", Path("/nonexistent"))
     assert {(e["seed"], e["synth"]["mesh"]) for e in tuning} == {(s, m) for s in range(10) for m in ("laser", "tsdf")}
+    second = load_spec("tuning_realistic_2", Path("/nonexistent"))
+    assert {(e["seed"], e["synth"]["mesh"]) for e in second} == {(s, m) for s in range(12, 18) for m in ("laser", "tsdf")}
+    held = {e["seed"] for e in heldout} | set(range(200, 211))
+    assert not held & ({e["seed"] for e in tuning} | {e["seed"] for e in second})  # tuning never touches held-apart seeds
 
 
 def test_synth_cli_scan_options(tmp_path: Path, capsys) -> None:  # noqa: ANN001
