@@ -23,7 +23,7 @@ from ...raster import Rasterizer
 from ...scene_io.images import frame_rgb
 from .facets import planar_facets
 from .fronts import Front, find_fronts
-from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts, floor_height, params_from_config
+from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts, floor_level, params_from_config
 from .reach import drawers_within_reach
 from .room_walls import keep_room_doors, room_wall_from_config
 from .sliding import SlidingRules, mark_sliding, sliding_from_config
@@ -73,9 +73,7 @@ class HeuristicModel:
         if walls is not None:  # on the room's outer walls only room doors open
             self.fronts = keep_room_doors(self.fronts, self.mesh, walls, rules, self.facets.labels)
         if h.drawer_max_top > 0 and self.fronts:  # drawers are within reach
-            floor = floor_height(self.mesh, h.floor_min_area)
-            floor = float(self.mesh.vertices[:, 2].min()) if floor is None else floor
-            self.fronts = drawers_within_reach(self.fronts, floor, h.drawer_max_top)
+            self.fronts = drawers_within_reach(self.fronts, floor_level(self.mesh, h.floor_min_area), h.drawer_max_top)
         if sliding is not None:
             mark_sliding(self.fronts, sliding)  # two fronts a track apart: sliding doors
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)

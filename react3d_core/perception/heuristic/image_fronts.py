@@ -117,6 +117,12 @@ def floor_height(mesh: TriMesh, min_area: float, band: float = 0.02, min_up: flo
     return float(zb[order][np.searchsorted(cum, 0.5 * cum[-1])])  # area-weighted median of the band
 
 
+def floor_level(mesh: TriMesh, min_area: float) -> float:
+    """:func:`floor_height`, else the mesh's lowest point (rules that need a floor always get one)."""
+    floor = floor_height(mesh, min_area)
+    return float(mesh.vertices[:, 2].min()) if floor is None else floor
+
+
 def off_the_floor(fronts: list[Front], floor: float | None, gap: float) -> list[Front]:
     """Fronts without a handle whose bottom edge is within ``gap`` of ``floor`` dropped (None: all kept)."""
     if floor is None:

@@ -22,7 +22,7 @@ import numpy as np
 from ...config.perception import HeuristicConfig
 from ...data.mesh import TriMesh
 from .fronts import Front, FrontRules, _joint, _neighbours
-from .image_fronts import floor_height
+from .image_fronts import floor_level
 
 _H = HeuristicConfig()
 
@@ -81,9 +81,7 @@ def keep_room_doors(fronts: list[Front], mesh: TriMesh, rules: RoomWallRules, fr
     wall = on_outer_wall(fronts, mesh, rules)
     if not any(wall):
         return list(fronts)
-    floor = floor_height(mesh, rules.floor_min_area)
-    if floor is None:
-        floor = float(mesh.vertices[:, 2].min())
+    floor = floor_level(mesh, rules.floor_min_area)
     door = [w and room_door_shaped(f, floor, rules) for f, w in zip(fronts, wall)]
     kept = [f for f, w, d in zip(fronts, wall, door) if d or not w]
     for f in (f for f, d in zip(fronts, door) if d):

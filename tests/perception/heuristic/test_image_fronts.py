@@ -696,4 +696,4 @@ def test_tall_unit_beside_a_base_run_splits_at_its_edge() -> None:
     assert abs(doors[0].c0 - 100) <= 2 and abs(doors[0].c1 - 200) <= 3 and abs(doors[1].c1 - 300) <= 2
     off = CellParams(outline_step=0.0)
     old = sorted((c for c in split_cells(o, cov, handles, off) if c.handles), key=lambda c: c.c0)
-    assert any(c.c0 < 90 or c.r0 < 200 for c in old)  # without them a door's cell is not its own
+    assert any(c.c0 < 90 or c.r0 < 200 for c in old)  # without it a door's cell is not its own
