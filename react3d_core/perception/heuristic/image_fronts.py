@@ -10,6 +10,7 @@ mesh fronts (handle position and shape, neighbours).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -206,21 +207,59 @@ def thin_lines(mask: np.ndarray, res: float, min_len: float, max_width: float) -
 
 
 def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
-                   depth: tuple[float, float] = _H.protrusion_depth) -> np.ndarray:
-    """Grid pixels under outward-facing faces standing ``depth`` in front of the plane (handles in
-    the mesh), splatted by centroid, closed over 2 px and grown by 1 px: the centroids of a bar's
-    faces sit half a face inside its outline, and a 1.5 cm bar at 4 mm must not come out 2 px wide."""
+                   depth: tuple[float, float] = _H.protrusion_depth, win: float = _H.handle_background_win,
+                   behind: float = _H.plane_offset_tol) -> np.ndarray:
+    """Grid pixels under outward-facing faces standing ``depth`` in front of the surface around them
+    (handles in the mesh), splatted by centroid, closed over 2 px and grown by 1 px: the centroids of a
+    bar's faces sit half a face inside its outline, and a 1.5 cm bar at 4 mm must not come out 2 px wide.
+
+    The surface around is the median offset of the faces within ``win`` (2 cm blocks, each its faces'
+    median), not the plane itself: a TSDF wall lies a centimetre or two off its fitted plane in places,
+    and its bumps there are no handles."""
     h, w = o.n_views.shape
     p = o.plane
     dn = centroids @ p.n - p.d
-    sel = (dn > depth[0]) & (dn < depth[1]) & (normals @ p.n > 0.5)
-    c = np.floor((centroids[sel] @ p.u - o.u0) / o.res).astype(int)
-    r = np.floor((o.v_top - centroids[sel, 2]) / o.res).astype(int)
-    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+    out_ = normals @ p.n > 0.5
+    c = np.floor((centroids @ p.u - o.u0) / o.res).astype(int)
+    r = np.floor((o.v_top - centroids[:, 2]) / o.res).astype(int)
+    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h) & out_ & (dn > -behind) & (dn < depth[1])
+    bg = _local_surface(dn[ok], r[ok], c[ok], (h, w), max(1, int(round(0.02 / o.res))), win / 0.02)
+    sel = np.flatnonzero(ok)
+    rise = dn[sel] - bg[r[sel], c[sel]]
+    sel = sel[(rise > depth[0]) & (rise < depth[1])]
     out = np.zeros((h, w), np.uint8)
-    out[r[ok], c[ok]] = 1
+    out[r[sel], c[sel]] = 1
     out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((5, 5), np.uint8))
     return cv2.dilate(out, np.ones((3, 3), np.uint8)).astype(bool)
+
+
+def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[int, int], block: int,
+                   win_blocks: float) -> np.ndarray:
+    """Per pixel: the median over a window of ``win_blocks`` blocks (odd, >= 3) of the per-block median
+    offsets ``dn`` of faces at (r, c); 0 (the plane) where fewer than a third of the window's blocks
+    (inside the grid) hold faces (a bar seen with little of the surface around it stands on the plane)."""
+    h, w = shape
+    bh, bw = -(-h // block), -(-w // block)
+    if not len(dn):
+        return np.zeros(shape)
+    bid = (r // block) * bw + c // block
+    order = np.lexsort((dn, bid))
+    cnt = np.bincount(bid, minlength=bh * bw)
+    start = np.concatenate([[0], np.cumsum(cnt)[:-1]])
+    coarse = np.full(bh * bw, np.nan)
+    has = cnt > 0
+    coarse[has] = dn[order][start[has] + cnt[has] // 2]
+    coarse = coarse.reshape(bh, bw)
+    k = max(3, int(round(win_blocks)) | 1)
+    padded = np.pad(coarse, k // 2, constant_values=np.nan)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # windows without faces stay NaN -> 0
+        win = np.lib.stride_tricks.sliding_window_view(padded, (k, k))
+        local = np.nanmedian(win, axis=(-2, -1))
+    inside = np.lib.stride_tricks.sliding_window_view(np.pad(np.ones(coarse.shape), k // 2), (k, k)).sum((-2, -1))
+    local[np.isfinite(win).sum((-2, -1)) * 3 < inside] = 0.0
+    local = np.nan_to_num(local, nan=0.0)
+    return np.repeat(np.repeat(local, block, 0), block, 1)[:h, :w]
 
 
 def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, read_rgb: Callable[[Frame], np.ndarray],
@@ -244,7 +283,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         diff = off_background(o, params.cells)
         diffs.append(diff)
         outline = cov_outline(cov, params.outline_fill_px)  # handle shadows are holes in the plane, not its outline
-        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals, params.protrusion_depth) & outline, outline)
+        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals, params.protrusion_depth, params.cells.background_win, params.plane_offset_tol) & outline, outline)
         shadows: list[Handle] = []
         if params.handle_shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
             eye_row = int(np.floor((o.v_top - float(np.median(cams[:, 2]))) / o.res))  # cameras' median height

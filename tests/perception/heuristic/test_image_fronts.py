@@ -454,6 +454,42 @@ def test_standing_bar_in_the_mesh_is_a_handle() -> None:
     assert hs[0].box == (49, 29, 53, 71)
 
 
+def test_protrusion_is_measured_from_the_surface_around() -> None:
+    """A wall whose right half lies 1.5 cm in front of its fitted plane (a TSDF wall is not flat): that
+    half is no protrusion (it was, against the plane: 1.5 cm > 1.2 cm); a bar 3 cm in front of it is."""
+    from react3d_core.perception.heuristic.image_fronts import protrusion_map
+
+    h, w, res = 100, 200, 0.004
+    o = _ortho(np.ones((h, w, 3), np.float32), res=res)            # plane y = 0 facing -y; v_top = 0.4
+    cols, rows = np.meshgrid(np.arange(0, w, 2), np.arange(0, h, 2))
+    x, z = (cols.ravel() + 0.5) * res, 0.4 - (rows.ravel() + 0.5) * res
+    wall = np.stack([x, np.where(cols.ravel() >= 100, -0.015, 0.0), z], 1)
+    bar = np.array([[(c + 0.5) * res, -0.015 - 0.03, 0.4 - (r + 0.5) * res] for c in (150, 151) for r in range(30, 70)])
+    cen = np.concatenate([wall, bar])
+    m = protrusion_map(o, cen, np.tile([0.0, -1.0, 0.0], (len(cen), 1)))
+    assert m[30:70, 150:152].all()
+    assert m.sum() == m[28:72, 148:154].sum() and m.sum() <= 44 * 6       # only the bar (closed, grown by 1 px)
+    assert not m[:, 100:140].any()
+
+
+def test_local_surface_hand_computed() -> None:
+    """Blocks of 2 px, window 3 blocks, a 12 x 12 px grid (6 x 6 blocks). Block (0, 0) holds offsets
+    0.01, 0.03, 0.02 (median 0.02), block (0, 1) holds 0.05. The window of block (0, 0) lies over 4
+    blocks of the grid, 2 of them filled (at least a third): median of 0.02 and 0.05 = 0.035. The window
+    of block (1, 1) lies over 9 blocks, 2 filled (under a third): the plane, 0. Far blocks: no faces, 0."""
+    from react3d_core.perception.heuristic.image_fronts import _local_surface
+
+    dn = np.array([0.01, 0.03, 0.02, 0.05])
+    r = np.array([0, 1, 1, 0])
+    c = np.array([0, 0, 1, 3])
+    s = _local_surface(dn, r, c, (12, 12), 2, 3)
+    assert s.shape == (12, 12)
+    assert np.allclose(s[0:2, 0:2], 0.035)              # block (0, 0)
+    assert np.allclose(s[0:2, 2:4], 0.035)              # block (0, 1): 6 blocks inside, 2 filled
+    assert np.allclose(s[2:4, 2:4], 0.0)                # block (1, 1)
+    assert np.allclose(s[6:, 6:], 0.0)
+
+
 def test_handle_found_from_its_shadow_alone() -> None:
     """A plain front whose bar handle left only an unseen hole (no colour anywhere): with the hole as
     handle evidence find_handles reports one horizontal handle there; without it, none."""
