@@ -55,6 +55,7 @@ class ImageFrontParams:
     line_min_len: float = _H.clutter_line_min_len        # m: straight lines this long (and thin) are a front's structure, not clutter
     line_max_width: float = _H.clutter_line_max_width    # m
     handle_shadows: bool = _H.handle_shadows            # enclosed unseen handle-shaped holes are handles
+    protrusion_from_surface: bool = _H.protrusion_from_surface  # mesh handles stand out from the surface around, not the plane (opt-in)
 
 
 def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
@@ -85,7 +86,8 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
         protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
         handleless_min_seams=cfg.handleless_min_seams, plain_floor_gap=cfg.plain_floor_gap,
         floor_min_area=cfg.floor_min_area, cell_median_clutter=cfg.clutter_cell_median,
-        line_min_len=cfg.clutter_line_min_len, line_max_width=cfg.clutter_line_max_width, handle_shadows=cfg.handle_shadows)
+        line_min_len=cfg.clutter_line_min_len, line_max_width=cfg.clutter_line_max_width, handle_shadows=cfg.handle_shadows,
+        protrusion_from_surface=cfg.protrusion_from_surface)
 
 
 @dataclass
@@ -207,15 +209,16 @@ def thin_lines(mask: np.ndarray, res: float, min_len: float, max_width: float) -
 
 
 def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
-                   depth: tuple[float, float] = _H.protrusion_depth, win: float = _H.handle_background_win,
+                   depth: tuple[float, float] = _H.protrusion_depth, win: float = 0.0,
                    behind: float = _H.plane_offset_tol) -> np.ndarray:
-    """Grid pixels under outward-facing faces standing ``depth`` in front of the surface around them
-    (handles in the mesh), splatted by centroid, closed over 2 px and grown by 1 px: the centroids of a
-    bar's faces sit half a face inside its outline, and a 1.5 cm bar at 4 mm must not come out 2 px wide.
+    """Grid pixels under outward-facing faces standing ``depth`` in front of the plane (handles in the
+    mesh), splatted by centroid, closed over 2 px and grown by 1 px: the centroids of a bar's faces sit
+    half a face inside its outline, and a 1.5 cm bar at 4 mm must not come out 2 px wide.
 
-    The surface around is the median offset of the faces within ``win`` (2 cm blocks, each its faces'
-    median), not the plane itself: a TSDF wall lies a centimetre or two off its fitted plane in places,
-    and its bumps there are no handles."""
+    With ``win`` > 0 (``protrusion_from_surface``, opt-in) they stand ``depth`` in front of the surface
+    around them instead: the median offset of the faces within ``win`` (2 cm blocks, each its faces'
+    median). A TSDF wall lies a centimetre or two off its fitted plane in places, and its bumps there
+    are no handles."""
     h, w = o.n_views.shape
     p = o.plane
     dn = centroids @ p.n - p.d
@@ -223,7 +226,8 @@ def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
     c = np.floor((centroids @ p.u - o.u0) / o.res).astype(int)
     r = np.floor((o.v_top - centroids[:, 2]) / o.res).astype(int)
     ok = (c >= 0) & (c < w) & (r >= 0) & (r < h) & out_ & (dn > -behind) & (dn < depth[1])
-    bg = _local_surface(dn[ok], r[ok], c[ok], (h, w), max(1, int(round(0.02 / o.res))), win / 0.02)
+    bg = (_local_surface(dn[ok], r[ok], c[ok], (h, w), max(1, int(round(0.02 / o.res))), win / 0.02) if win > 0
+          else np.zeros((h, w)))
     sel = np.flatnonzero(ok)
     rise = dn[sel] - bg[r[sel], c[sel]]
     sel = sel[(rise > depth[0]) & (rise < depth[1])]
@@ -283,7 +287,9 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         diff = off_background(o, params.cells)
         diffs.append(diff)
         outline = cov_outline(cov, params.outline_fill_px)  # handle shadows are holes in the plane, not its outline
-        handles = find_handles(o, cov, params.cells, diff, protrusion_map(o, centroids, normals, params.protrusion_depth, params.cells.background_win, params.plane_offset_tol) & outline, outline)
+        win = params.cells.background_win if params.protrusion_from_surface else 0.0
+        bars = protrusion_map(o, centroids, normals, params.protrusion_depth, win, params.plane_offset_tol)
+        handles = find_handles(o, cov, params.cells, diff, bars & outline, outline)
         shadows: list[Handle] = []
         if params.handle_shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
             eye_row = int(np.floor((o.v_top - float(np.median(cams[:, 2]))) / o.res))  # cameras' median height

@@ -455,8 +455,9 @@ def test_standing_bar_in_the_mesh_is_a_handle() -> None:
 
 
 def test_protrusion_is_measured_from_the_surface_around() -> None:
-    """A wall whose right half lies 1.5 cm in front of its fitted plane (a TSDF wall is not flat): that
-    half is no protrusion (it was, against the plane: 1.5 cm > 1.2 cm); a bar 3 cm in front of it is."""
+    """A wall whose right half lies 1.5 cm in front of its fitted plane (a TSDF wall is not flat), and a
+    bar 3 cm in front of that half. Against the plane (the default) the whole right half is protrusion
+    (1.5 cm > 1.2 cm); against the surface around (``protrusion_from_surface``: 12 cm window) only the bar."""
     from react3d_core.perception.heuristic.image_fronts import protrusion_map
 
     h, w, res = 100, 200, 0.004
@@ -466,10 +467,12 @@ def test_protrusion_is_measured_from_the_surface_around() -> None:
     wall = np.stack([x, np.where(cols.ravel() >= 100, -0.015, 0.0), z], 1)
     bar = np.array([[(c + 0.5) * res, -0.015 - 0.03, 0.4 - (r + 0.5) * res] for c in (150, 151) for r in range(30, 70)])
     cen = np.concatenate([wall, bar])
-    m = protrusion_map(o, cen, np.tile([0.0, -1.0, 0.0], (len(cen), 1)))
+    nrm = np.tile([0.0, -1.0, 0.0], (len(cen), 1))
+    plane = protrusion_map(o, cen, nrm)
+    assert plane[:, 100:].all() and not plane[:, :99].any()
+    m = protrusion_map(o, cen, nrm, win=0.12)
     assert m[30:70, 150:152].all()
     assert m.sum() == m[28:72, 148:154].sum() and m.sum() <= 44 * 6       # only the bar (closed, grown by 1 px)
-    assert not m[:, 100:140].any()
 
 
 def test_local_surface_hand_computed() -> None:
