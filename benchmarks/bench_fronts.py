@@ -27,8 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 def score_scene(scene_dir: str, overrides: dict[str, Any]) -> dict[str, Any]:
     """Build the heuristic on one scene folder (stride 1, as ``react3d bench``) and score its fronts."""
-    import numpy as np
-
+    from benchmarks.miss_causes import gt_part_faces
     from benchmarks.runner import _gt_dir
     from react3d_core.config import PipelineConfig
     from react3d_core.ground_truth.articulate3d import read_articulate3d
@@ -44,31 +43,18 @@ def score_scene(scene_dir: str, overrides: dict[str, Any]) -> dict[str, Any]:
     cfg = PipelineConfig().with_overrides({"perception": {"heuristic": overrides}, "frames": {"stride": 1}})
     model = HeuristicModel(load_scene(d, cfg.frames), cfg.perception.heuristic)
     gt = read_articulate3d(gt_dir)
-    parts = [(p, np.unique(np.concatenate([p.tri_indices] + [c.tri_indices for c in gt.parts
-                                                             if c.label.startswith(p.label + ".") and not c.movable])))
-             for p in gt.movable]
-    s = match_fronts([f for _, f in parts], [fr.faces for fr in model.fronts], model.mesh.face_areas)
+    faces = gt_part_faces(gt)  # each movable part with its handles
+    s = match_fronts([faces[p.part_id] for p in gt.movable], [fr.faces for fr in model.fronts], model.mesh.face_areas)
     typed = sum(1 for i, j, _ in s.pairs if model.fronts[j].articulation is not None
-                and model.fronts[j].articulation.joint_type == parts[i][0].articulation.joint_type)
+                and model.fronts[j].articulation.joint_type == gt.movable[i].articulation.joint_type)
     return {"scene": d.name, "tp": s.tp, "pred": s.n_pred, "gt": s.n_gt, "precision": s.precision, "recall": s.recall,
             "f1": s.f1, "joint_type_ok": typed, "seconds": time.perf_counter() - t0}
 
 
 def _scene_dirs(spec: str, out: Path) -> list[str]:
-    from benchmarks.runner import load_spec
+    from benchmarks.runner import ensure_scene, load_spec
 
-    entries = load_spec(spec, out)
-    for e in entries:
-        d = Path(e["scene_dir"])
-        if "source" in e and not (any((d / "scans").glob("*.ply")) and (d / "articulate3d").is_dir()):
-            from react3d_core.synthetic import generate_scene
-
-            o = e["synth"]
-            print(f"generating {d.name} ...", flush=True)
-            generate_scene(d, source=e["source"], seed=e["seed"], n_frames=e["n_frames"], kind=e["kind"],
-                           mesh=o.get("mesh", "clean"), realism=o.get("realism", "photo"),
-                           misregister=tuple(o.get("misregister", (0, 0))))
-    return [e["scene_dir"] for e in entries]
+    return [str(ensure_scene(e)) for e in load_spec(spec, out)]
 
 
 def main(argv: list[str] | None = None) -> dict[str, Any]:

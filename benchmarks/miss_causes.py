@@ -21,7 +21,7 @@ if TYPE_CHECKING:
     from react3d_core.ground_truth import GroundTruth
 
 
-def _gt_faces(gt: GroundTruth) -> dict[int, np.ndarray]:
+def gt_part_faces(gt: GroundTruth) -> dict[int, np.ndarray]:
     """Face ids of each movable GT part with the parts below it in the label hierarchy (handles)."""
     out = {}
     for p in gt.movable:
@@ -130,7 +130,7 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
         rows = sm.parts
     preds = [PredictedJoint(o.articulation, o.initial_articulation, o.obb, np.asarray(o.front_normal, float),
                             is_flat(o.obb, cfg.articulation.flat_ratio)) for o in manifest.objects]
-    faces = _gt_faces(gt)
+    faces = gt_part_faces(gt)
     boxes = {}
     for pid, f in faces.items():
         f = f[(f >= 0) & (f < mesh.n_faces)]

@@ -79,6 +79,17 @@ def cold_cache(root: str | Path) -> Iterator[Path]:
         shutil.rmtree(root, ignore_errors=True)
 
 
+def ensure_scene(entry: dict[str, Any]) -> Path:
+    """The entry's scene folder, generated first when the set names a synthetic scene not yet there."""
+    scene_dir = Path(entry["scene_dir"])
+    if "source" in entry and not (scene_dir / "scans").is_dir():
+        from react3d_core.synthetic import generate_scene
+
+        generate_scene(scene_dir, source=entry["source"], seed=entry["seed"], n_frames=entry["n_frames"], kind=entry.get("kind"),
+                       **entry.get("synth", {}))
+    return scene_dir
+
+
 def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold: str | None = None,
             miss_causes: bool = False) -> dict[str, Any]:
     """Child-process body: generate if missing, convert (timed), return timings and peak RSS.
@@ -87,12 +98,7 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
     ``miss_causes``: also attribute each missed / mis-jointed GT part to a stage (benchmarks.miss_causes), after
     the timings and peak memory are taken.
     """
-    scene_dir = Path(entry["scene_dir"])
-    if "source" in entry and not (scene_dir / "scans").is_dir():
-        from react3d_core.synthetic import generate_scene
-
-        generate_scene(scene_dir, source=entry["source"], seed=entry["seed"], n_frames=entry["n_frames"], kind=entry.get("kind"),
-                       **entry.get("synth", {}))
+    scene_dir = ensure_scene(entry)
     from flows.convert_scene import convert_scene
 
     rss0 = _peak_rss_mb()

@@ -107,23 +107,28 @@ def _incidence(sets: list[np.ndarray], inv: np.ndarray, n_cols: int) -> sparse.c
     return sparse.csr_matrix((np.ones(len(rows)), (rows, inv)), shape=(len(sets), n_cols))
 
 
-def overlap_counts(a_sets: Sequence[np.ndarray], b_sets: Sequence[np.ndarray] | None = None
-                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``inter[i, j] = |A_i & B_j|`` (dense float, exact counts) and the set sizes ``|A_i|``, ``|B_j|``.
+def overlap_counts(a_sets: Sequence[np.ndarray], b_sets: Sequence[np.ndarray] | None = None,
+                   weights: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``inter[i, j] = |A_i & B_j|`` (dense float, exact counts) and the set sizes ``|A_i|``, ``|B_j|``;
+    with ``weights`` (one per id, e.g. face areas) each id counts its weight instead of 1.
 
     Ids are deduplicated; ``b_sets=None`` compares ``a_sets`` with themselves. One sparse incidence
     product over the ids that occur (no Python loop over pairs)."""
     a = _unique_sets(a_sets)
     b = a if b_sets is None else _unique_sets(b_sets)
-    size_a = np.array([len(s) for s in a], float)
-    size_b = size_a if b_sets is None else np.array([len(s) for s in b], float)
+    w = None if weights is None else np.asarray(weights, float)
+    size_a = np.array([len(s) if w is None else w[s].sum() for s in a], float)
+    size_b = size_a if b_sets is None else np.array([len(s) if w is None else w[s].sum() for s in b], float)
     if not a or not b:
         return np.zeros((len(a), len(b))), size_a, size_b
     both = a if b_sets is None else a + b
     ids, inv = np.unique(np.concatenate(both), return_inverse=True)
     inv = inv.ravel()
-    A = _incidence(a, inv[: int(size_a.sum())], len(ids))
-    B = A if b_sets is None else _incidence(b, inv[int(size_a.sum()):], len(ids))
+    n_a = sum(len(s) for s in a)
+    A = _incidence(a, inv[:n_a], len(ids))
+    B = A if b_sets is None else _incidence(b, inv[n_a:], len(ids))
+    if w is not None:  # weighted on one side only: the product sums each shared id's weight once
+        A = A.multiply(w[ids][None, :]).tocsr()
     return (A @ B.T).toarray(), size_a, size_b
 
 
@@ -133,9 +138,11 @@ def iou_from_counts(inter: np.ndarray, size_a: np.ndarray, size_b: np.ndarray) -
     return np.divide(inter, union, out=np.zeros_like(inter, dtype=float), where=union > 0)
 
 
-def iou_matrix(a_sets: Sequence[np.ndarray], b_sets: Sequence[np.ndarray] | None = None) -> np.ndarray:
-    """(len(a), len(b)) IoU of id sets (vertex ids, face ids); ids deduplicated, empty-vs-empty 0."""
-    return iou_from_counts(*overlap_counts(a_sets, b_sets))
+def iou_matrix(a_sets: Sequence[np.ndarray], b_sets: Sequence[np.ndarray] | None = None,
+               weights: np.ndarray | None = None) -> np.ndarray:
+    """(len(a), len(b)) IoU of id sets (vertex ids, face ids); ids deduplicated, empty-vs-empty 0;
+    ``weights`` per id (face areas: area IoU)."""
+    return iou_from_counts(*overlap_counts(a_sets, b_sets, weights))
 
 
 def vertex_iou(a: np.ndarray, b: np.ndarray, assume_unique: bool = False) -> float:

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..geometry import iou_matrix
+
 
 @dataclass(frozen=True)
 class FrontScore:
@@ -40,28 +42,10 @@ class FrontScore:
         return 2 * self.tp / (self.n_pred + self.n_gt) if self.n_pred + self.n_gt else 0.0
 
 
-def area_iou_matrix(gt: Sequence[np.ndarray], pred: Sequence[np.ndarray], face_area: np.ndarray) -> np.ndarray:
-    """(len(gt), len(pred)) IoU of face-id sets weighted by ``face_area`` (duplicate ids count once)."""
-    n = len(face_area)
-    out = np.zeros((len(gt), len(pred)))
-    if not len(gt) or not len(pred):
-        return out
-    P = np.zeros((len(pred), n), bool)
-    for j, f in enumerate(pred):
-        P[j, np.asarray(f, np.int64)] = True
-    pa = P @ face_area
-    for i, g in enumerate(gt):
-        g = np.unique(np.asarray(g, np.int64))
-        inter = P[:, g] @ face_area[g]
-        union = face_area[g].sum() + pa - inter
-        out[i] = np.where(union > 0, inter / np.maximum(union, 1e-12), 0.0)
-    return out
-
-
 def match_fronts(gt: Sequence[np.ndarray], pred: Sequence[np.ndarray], face_area: np.ndarray,
                  threshold: float = 0.5) -> FrontScore:
     """Greedy one-to-one matching by area IoU (highest first) at ``threshold``."""
-    iou = area_iou_matrix(gt, pred, face_area)
+    iou = iou_matrix(gt, pred, face_area)
     cand = sorted(((float(iou[i, j]), i, j) for i, j in zip(*np.nonzero(iou >= threshold))), reverse=True)
     used_g: set[int] = set()
     used_p: set[int] = set()

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from react3d_core.metrics.front_match import area_iou_matrix, match_fronts
+from react3d_core.geometry import iou_matrix
+from react3d_core.metrics.front_match import match_fronts
 
 AREA = np.array([1.0, 1.0, 2.0, 2.0, 1.0, 3.0])
 
@@ -16,7 +17,7 @@ def test_area_iou_hand_computed() -> None:
     = 0.375. Prediction {3, 4}: with B 1.0."""
     gt = [np.array([0, 1, 2]), np.array([3, 4])]
     pred = [np.array([0, 1]), np.array([2, 3, 4, 5]), np.array([3, 4])]
-    iou = area_iou_matrix(gt, pred, AREA)
+    iou = iou_matrix(gt, pred, AREA)
     assert iou == pytest.approx(np.array([[0.5, 0.2, 0.0], [0.0, 0.375, 1.0]]))
     s = match_fronts(gt, pred, AREA)
     assert s.pairs == ((0, 0, 0.5), (1, 2, 1.0))         # IoU 0.5 counts (>=); 0.375 does not

@@ -222,15 +222,15 @@ def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
     h, w = o.n_views.shape
     p = o.plane
     dn = centroids @ p.n - p.d
-    out_ = normals @ p.n > 0.5
-    c = np.floor((centroids @ p.u - o.u0) / o.res).astype(int)
-    r = np.floor((o.v_top - centroids[:, 2]) / o.res).astype(int)
-    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h) & out_ & (dn > -behind) & (dn < depth[1])
-    bg = (_local_surface(dn[ok], r[ok], c[ok], (h, w), max(1, int(round(0.02 / o.res))), win / 0.02) if win > 0
-          else np.zeros((h, w)))
-    sel = np.flatnonzero(ok)
-    rise = dn[sel] - bg[r[sel], c[sel]]
-    sel = sel[(rise > depth[0]) & (rise < depth[1])]
+    # outward faces that can stand out: against the plane, from depth[0]; against the surface, from behind it
+    cand = np.flatnonzero((dn > (-behind if win > 0 else depth[0])) & (dn < depth[1]) & (normals @ p.n > 0.5))
+    c = np.floor((centroids[cand] @ p.u - o.u0) / o.res).astype(int)
+    r = np.floor((o.v_top - centroids[cand, 2]) / o.res).astype(int)
+    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+    dn, r, c = dn[cand][ok], r[ok], c[ok]
+    if win > 0:
+        dn = dn - _local_surface(dn, r, c, (h, w), max(1, int(round(0.02 / o.res))), win / 0.02)[r, c]
+    sel = (dn > depth[0]) & (dn < depth[1])
     out = np.zeros((h, w), np.uint8)
     out[r[sel], c[sel]] = 1
     out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((5, 5), np.uint8))
