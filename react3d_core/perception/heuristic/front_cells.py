@@ -42,6 +42,7 @@ class CellParams:
     min_seen: float = _H.cell_min_seen           # a cell's mesh coverage fraction
     max_clutter: float = _H.max_clutter          # fraction of a cell's pixels off its local background (posters, tiles, shelves)
     max_clutter_handle: float = _H.max_clutter_handle  # the same for a cell holding a handle
+    side_cover: float = _H.handle_side_cover     # outline cover of the band on each long side of a handle
     outline_margin: float = _H.handle_outline_margin  # m: colour blobs this close to the plane's outline are not handles
     texture_factor: float = _H.texture_factor    # handle/seam thresholds rise to this many times the plane's median response
     seam_z: float = _H.seam_z                    # a straight seam: the line's median brightness dips this many noise units below its neighbours
@@ -187,11 +188,28 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.nd
         # a handle sits on the front: mesh coverage around it on both sides across its length
         pad = max(2, int(0.02 / o.res))
         r0, r1, c0, c1 = max(0, y - pad), min(lab.shape[0], y + h + pad), max(0, x - pad), min(lab.shape[1], x + w + pad)
-        if (coverage if outline is None else outline)[r0:r1, c0:c1].mean() < 0.4:
+        ref = coverage if outline is None else outline
+        if ref[r0:r1, c0:c1].mean() < 0.4:
+            continue
+        if p.side_cover > 0 and min(_side_cover(ref, (x, y, w, h), pad)) < p.side_cover:
             continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1)))
     return out
+
+
+def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int) -> tuple[float, float]:
+    """Share of the ``pad``-wide bands along both long sides of ``box`` (x, y, w, h) that ``ref`` covers;
+    band pixels beyond the grid count as uncovered (the plane ends there)."""
+    x, y, w, h = box
+    H, W = ref.shape
+    if w >= h:  # horizontal: above and below
+        bands = [ref[max(0, y - pad):y, x:x + w], ref[y + h:min(H, y + h + pad), x:x + w]]
+        full = pad * w
+    else:  # vertical: left and right
+        bands = [ref[y:y + h, max(0, x - pad):x], ref[y:y + h, x + w:min(W, x + w + pad)]]
+        full = pad * h
+    return float(bands[0].sum()) / full, float(bands[1].sum()) / full
 
 
 def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], p: CellParams) -> list[Cell]:

@@ -76,6 +76,7 @@ def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
                          handle_thick=tuple(cfg.handle_thick), handle_aspect=cfg.handle_aspect,
                          background_win=cfg.handle_background_win, min_seen=cfg.cell_min_seen,
                          max_clutter=cfg.max_clutter, max_clutter_handle=cfg.max_clutter_handle, outline_margin=cfg.handle_outline_margin,
+                         side_cover=cfg.handle_side_cover,
                          texture_factor=cfg.texture_factor, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
                          step_z=cfg.step_z, max_depth=cfg.max_split_depth, step_over_dip=cfg.step_over_dip,
                          outline_step=cfg.outline_step),

@@ -454,6 +454,38 @@ def test_standing_bar_in_the_mesh_is_a_handle() -> None:
     assert hs[0].box == (49, 29, 53, 71)
 
 
+def test_side_cover_hand_computed() -> None:
+    """Bands of 2 px along the long sides of a box; pixels beyond the grid count as uncovered."""
+    from react3d_core.perception.heuristic.front_cells import _side_cover
+
+    ref = np.zeros((10, 12), bool)
+    ref[:, 4:] = True                           # covered from column 4 on
+    # vertical box at columns 5-6, rows 2-5: left band columns 3-4 (half covered), right band 7-8 (all)
+    assert _side_cover(ref, (5, 2, 2, 4), 2) == pytest.approx((0.5, 1.0))
+    # vertical box at columns 0-1: the left band lies beyond the grid (0), the right band 2-3 is uncovered
+    assert _side_cover(ref, (0, 2, 2, 4), 2) == pytest.approx((0.0, 0.0))
+    # horizontal box at row 0, columns 4-9: above beyond the grid (0), below rows 1-2 covered
+    assert _side_cover(ref, (4, 0, 6, 1), 2) == pytest.approx((0.0, 1.0))
+    # horizontal box at row 4, columns 2-5: bands above (rows 2-3) and below (rows 5-6) each 2 of 4 columns
+    assert _side_cover(ref, (2, 4, 4, 1), 2) == pytest.approx((0.5, 0.5))
+
+
+def test_ridge_at_the_planes_end_is_no_handle() -> None:
+    """A 6 cm x 32 cm ridge in the mesh at a plane's left end (a wall corner, a unit's side: the plane
+    on one side only) passes the overall cover test but not ``side_cover``; the same bar in the middle
+    of the plane stays a handle either way. RedKitchen, stride 5: such a ridge at the end of the tiled
+    wall became a door with protrusion_from_surface."""
+    h, w, res = 150, 200, 0.004
+    o = _ortho(np.ones((h, w, 3), np.float32), res=res)
+    cov = np.ones((h, w), bool)
+    on = CellParams(side_cover=0.4)
+    for c0, kept_with in ((0, False), (90, True)):
+        bar = np.zeros((h, w), bool)
+        bar[40:120, c0:c0 + 15] = True
+        assert len(find_handles(o, cov, CellParams(), None, bar, cov)) == 1
+        assert (len(find_handles(o, cov, on, None, bar, cov)) == 1) == kept_with
+
+
 def test_protrusion_is_measured_from_the_surface_around() -> None:
     """A wall whose right half lies 1.5 cm in front of its fitted plane (a TSDF wall is not flat), and a
     bar 3 cm in front of that half. Against the plane (the default) the whole right half is protrusion
