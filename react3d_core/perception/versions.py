@@ -13,9 +13,10 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     typed as side-hinged doors (room_wall)
 # 13: image cells are cut first at an L-shaped outline's corner (outline_step); drawer-typed fronts
 #     above 1.7 m are dropped (drawer_max_top)
-# (per-view colour registration, register_sigmas_px, and handles standing out from the surface around
-# them, protrusion_from_surface, are opt-in: off they change nothing, and the configuration a run uses
-# is part of the cache key)
-HEURISTIC_VERSION = "13"
+# 14: handles in the mesh stand out from the surface around them, not the fitted plane
+#     (protrusion_from_surface), and a handle has the plane's outline on both long sides (handle_side_cover)
+# (per-view colour registration, register_sigmas_px, is opt-in: off it changes nothing, and the
+# configuration a run uses is part of the cache key)
+HEURISTIC_VERSION = "14"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

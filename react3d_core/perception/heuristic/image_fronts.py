@@ -55,7 +55,7 @@ class ImageFrontParams:
     line_min_len: float = _H.clutter_line_min_len        # m: straight lines this long (and thin) are a front's structure, not clutter
     line_max_width: float = _H.clutter_line_max_width    # m
     handle_shadows: bool = _H.handle_shadows            # enclosed unseen handle-shaped holes are handles
-    protrusion_from_surface: bool = _H.protrusion_from_surface  # mesh handles stand out from the surface around, not the plane (opt-in)
+    protrusion_from_surface: bool = _H.protrusion_from_surface  # mesh handles stand out from the surface around, not the plane
 
 
 def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
@@ -216,7 +216,7 @@ def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
     mesh), splatted by centroid, closed over 2 px and grown by 1 px: the centroids of a bar's faces sit
     half a face inside its outline, and a 1.5 cm bar at 4 mm must not come out 2 px wide.
 
-    With ``win`` > 0 (``protrusion_from_surface``, opt-in) they stand ``depth`` in front of the surface
+    With ``win`` > 0 (``protrusion_from_surface``, the default since version 14) they stand ``depth`` in front of the surface
     around them instead: the median offset of the faces within ``win`` (2 cm blocks, each its faces'
     median). A TSDF wall lies a centimetre or two off its fitted plane in places, and its bumps there
     are no handles."""

@@ -472,17 +472,17 @@ def test_side_cover_hand_computed() -> None:
 
 def test_ridge_at_the_planes_end_is_no_handle() -> None:
     """A 6 cm x 32 cm ridge in the mesh at a plane's left end (a wall corner, a unit's side: the plane
-    on one side only) passes the overall cover test but not ``side_cover``; the same bar in the middle
+    on one side only) passes the overall cover test but not ``side_cover`` (0.4, the default); the same bar in the middle
     of the plane stays a handle either way. RedKitchen, stride 5: such a ridge at the end of the tiled
     wall became a door with protrusion_from_surface."""
     h, w, res = 150, 200, 0.004
     o = _ortho(np.ones((h, w, 3), np.float32), res=res)
     cov = np.ones((h, w), bool)
-    on = CellParams(side_cover=0.4)
+    on, off = CellParams(side_cover=0.4), CellParams(side_cover=0.0)
     for c0, kept_with in ((0, False), (90, True)):
         bar = np.zeros((h, w), bool)
         bar[40:120, c0:c0 + 15] = True
-        assert len(find_handles(o, cov, CellParams(), None, bar, cov)) == 1
+        assert len(find_handles(o, cov, off, None, bar, cov)) == 1
         assert (len(find_handles(o, cov, on, None, bar, cov)) == 1) == kept_with
 
 
