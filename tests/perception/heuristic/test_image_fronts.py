@@ -488,8 +488,9 @@ def test_ridge_at_the_planes_end_is_no_handle() -> None:
 
 def test_protrusion_is_measured_from_the_surface_around() -> None:
     """A wall whose right half lies 1.5 cm in front of its fitted plane (a TSDF wall is not flat), and a
-    bar 3 cm in front of that half. Against the plane (the default) the whole right half is protrusion
-    (1.5 cm > 1.2 cm); against the surface around (``protrusion_from_surface``: 12 cm window) only the bar."""
+    bar 3 cm in front of that half. Against the plane (``win`` 0, the rule up to heuristic version 13) the
+    whole right half is protrusion (1.5 cm > 1.2 cm); against the surface around (``protrusion_from_surface``,
+    the default since version 14: 12 cm window) only the bar."""
     from react3d_core.perception.heuristic.image_fronts import protrusion_map
 
     h, w, res = 100, 200, 0.004
