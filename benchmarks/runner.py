@@ -150,7 +150,7 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
     ``cold``: each scene converts with an empty cache (under ``out_dir/cold-cache``, removed after).
     ``miss_causes``: each scene gets ``miss_causes`` (counts per cause and one row per traced GT part)
     and the result a pooled ``miss_causes`` (every cause key present; docs/evaluation.md)."""
-    from react3d_core.config.evaluation import EvaluationConfig
+    from react3d_core.config.metrics import EvaluationConfig
     from react3d_core.data.parts import InteractiveScene
     from react3d_core.ground_truth.articulate3d import read_articulate3d
     from react3d_core.metrics import evaluate_scene, to_json_dict

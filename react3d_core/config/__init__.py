@@ -1,5 +1,8 @@
 """The one pipeline config: every threshold with the paper's default and what it does.
 
+One module per stage package, named after it (``config/cavity.py`` holds the ``cavity`` section read by
+``react3d_core/cavity``); this module composes them into :class:`PipelineConfig`.
+
 Load from JSON/YAML-like dicts with ``PipelineConfig.model_validate(d)``; a run records
 ``config.model_dump(mode="json")`` in its manifest.
 """
@@ -13,12 +16,16 @@ from pydantic import Field, ValidationError
 
 from ..errors import ConfigError
 from ._base import StageConfig
-from .articulation import ArticulationConfig, AssemblyConfig, CavityConfig, DedupConfig, LimitConfig
-from .evaluation import EvaluationConfig
+from .articulation import ArticulationConfig, LimitConfig
+from .assembly import AssemblyConfig
+from .cavity import CavityConfig
+from .dedup import DedupConfig
 from .export import ExportConfig
-from .frames import FrameSelectionConfig
-from .perception import FrontRulesConfig, HeuristicConfig, OracleNoiseConfig, PerceptionConfig
-from .segmentation import ClipConfig, FusionConfig, TopKConfig
+from .fusion import ClipConfig, FusionConfig, TopKConfig
+from .heuristic import FrontRulesConfig, HeuristicConfig
+from .metrics import EvaluationConfig
+from .perception import OracleNoiseConfig, PerceptionConfig
+from .scene_io import FrameSelectionConfig
 
 
 class PipelineConfig(StageConfig):

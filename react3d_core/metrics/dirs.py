@@ -6,7 +6,7 @@ from pathlib import Path
 from typing import Any
 
 from ..atomic import write_json
-from ..config.evaluation import EvaluationConfig
+from ..config.metrics import EvaluationConfig
 from ..data.parts import InteractiveScene
 from ..errors import InputError
 from ..ground_truth.articulate3d import read_articulate3d

@@ -52,7 +52,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config.evaluation import EvaluationConfig
+from ..config.metrics import EvaluationConfig
 from ..data.parts import OBB, Articulation
 from .geometry import axis_error_deg, joint_class, line_distance
 

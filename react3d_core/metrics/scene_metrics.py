@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..config.evaluation import EvaluationConfig
+from ..config.metrics import EvaluationConfig
 from ..data.mesh import load_mesh
 from ..data.parts import Articulation, InteractiveScene, load_vertex_ids
 from ..errors import InputError

@@ -17,7 +17,7 @@ from PIL import Image as PILImage
 import numpy as np
 
 from ..camera import K_SIZE, nerfstudio_scannetpp_to_c2w, opengl_to_opencv_c2w
-from ..config.frames import FrameSelectionConfig
+from ..config.scene_io import FrameSelectionConfig
 from ..data.frames import Frame, ImageRef, Intrinsics, SceneInput, validate_pose
 from ..errors import InputError
 from ..raster import Rasterizer

@@ -20,7 +20,7 @@ from typing import Any, Protocol
 import numpy as np
 
 from ..camera import unproject
-from ..config.frames import FrameSelectionConfig
+from ..config.scene_io import FrameSelectionConfig
 from ..data.frames import Frame
 from ..raster import Rasterizer
 

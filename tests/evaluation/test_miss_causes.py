@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from react3d_core.config.evaluation import EvaluationConfig
+from react3d_core.config.metrics import EvaluationConfig
 from react3d_core.data.parts import OBB, Articulation
 from react3d_core.metrics.miss_causes import (JOINT_CAUSES, MISS_CAUSES, PredictedJoint, ProposalTrace, StageOutputs,
                                              attribute_scene, coincident_parts, joint_causes, pool_counts)

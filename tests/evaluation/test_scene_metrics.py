@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from react3d_core.config.evaluation import EvaluationConfig
+from react3d_core.config.metrics import EvaluationConfig
 from react3d_core.data.parts import Articulation
 from react3d_core.metrics import evaluate_sets, iou_matrix, summarize, to_json_dict
 from react3d_core.metrics.scene_metrics import aggregate

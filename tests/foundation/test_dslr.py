@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from react3d_core.camera import c2w_to_colmap, look_at
-from react3d_core.config.frames import FrameSelectionConfig
+from react3d_core.config.scene_io import FrameSelectionConfig
 from react3d_core.data.mesh import TriMesh, save_mesh
 from react3d_core.errors import InputError
 from react3d_core.scene_io import load_scene

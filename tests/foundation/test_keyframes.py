@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from react3d_core.camera import look_at
-from react3d_core.config.frames import FrameSelectionConfig
+from react3d_core.config.scene_io import FrameSelectionConfig
 from react3d_core.data.frames import Frame, ImageRef, Intrinsics
 from react3d_core.raster import Rasterizer
 from react3d_core.scene_io import load_scene

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from react3d_core.camera import look_at, opencv_to_opengl_c2w
-from react3d_core.config.frames import FrameSelectionConfig
+from react3d_core.config.scene_io import FrameSelectionConfig
 from react3d_core.data.mesh import TriMesh, save_mesh
 from react3d_core.errors import InputError
 from react3d_core.scene_io import load_scene, select_frames

@@ -15,7 +15,7 @@ from typing import Any
 import cv2
 import numpy as np
 
-from ...config.perception import HeuristicConfig
+from ...config.heuristic import HeuristicConfig
 from ...data.frames import Frame, SceneInput
 from ...data.masks import ArticulationPrediction, Mask2D
 from ...data.mesh import TriMesh, load_mesh

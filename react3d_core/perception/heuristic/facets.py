@@ -13,7 +13,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ...config.perception import HeuristicConfig
+from ...config.heuristic import HeuristicConfig
 from ...data.mesh import TriMesh
 from ...geometry import edge_adjacency
 

@@ -19,7 +19,7 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from ...config.perception import HeuristicConfig
+from ...config.heuristic import HeuristicConfig
 from .orthophoto import Orthophoto
 
 _H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic)

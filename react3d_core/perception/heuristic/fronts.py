@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ...config.perception import FrontRulesConfig
+from ...config.heuristic import FrontRulesConfig
 from ...data.mesh import TriMesh
 from ...data.parts import Articulation
 from ...geometry import horizontal_right

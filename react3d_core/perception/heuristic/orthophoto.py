@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ...config.perception import HeuristicConfig
+from ...config.heuristic import HeuristicConfig
 from ...data.frames import Frame
 from ...raster import Rasterizer
 from .colour_sampling import ColourCalibration, Points as _Points, nanmedian as _nanmedian, \

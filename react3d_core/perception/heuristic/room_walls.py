@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...config.perception import HeuristicConfig
+from ...config.heuristic import HeuristicConfig
 from ...data.mesh import TriMesh
 from .fronts import Front, FrontRules, _joint, _neighbours
 from .image_fronts import floor_level

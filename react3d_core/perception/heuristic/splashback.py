@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...config.perception import HeuristicConfig
+from ...config.heuristic import HeuristicConfig
 from ...data.mesh import TriMesh
 from .fronts import Front
 

@@ -30,7 +30,7 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from ...config.perception import HeuristicConfig
+from ...config.heuristic import HeuristicConfig
 from ...data.frames import Frame
 from .colour_sampling import ColourCalibration, Points, nanmedian, pixel_coords, remap_points
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from react3d_core.config.perception import FrontRulesConfig, HeuristicConfig
+from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.geometry import concat_meshes
 from react3d_core.perception.heuristic.fronts import Front

@@ -1,0 +1,19 @@
+"""Hidden geometry behind a movable part."""
+
+from pydantic import Field
+
+from ._base import StageConfig
+
+
+class CavityConfig(StageConfig):
+    """Hidden geometry behind a movable part (d_in = min(d_image, d_hit, d_mesh, d_body))."""
+
+    ignore_hits_thickness_factor: float = Field(2.0, ge=0, description="Ignore scene hits closer than this x part thickness.")
+    search_radius_factor: float = Field(0.1, ge=0, description="Probe radius = factor x longest OBB edge.")
+    wall_factor: float = Field(0.03, gt=0, description="Wall thickness = factor x shortest front edge.")
+    min_wall_m: float = Field(0.008, gt=0, description="Minimum wall thickness (m).")
+    default_depth_m: float = Field(0.5, gt=0, description="Depth used when no bound is available.")
+    max_depth_m: float = Field(1.2, gt=0, description="Upper clamp on cavity depth.")
+    body_step_m: float = Field(0.02, gt=0, description="d_body: depth step of the up-ray profile behind the front (at most prismatic_margin_m keeps travel inside the body).")
+    body_jump_m: float = Field(0.15, gt=0, description="d_body: an up-ray this much farther than inside the carcass (or missing) is past the furniture's back.")
+    body_lateral_factor: float = Field(0.3, ge=0, le=0.5, description="d_body: up-rays at 0 and +-factor x the front's width from its centre (median).")

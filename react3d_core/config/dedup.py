@@ -1,0 +1,17 @@
+"""Duplicate part removal."""
+
+from pydantic import Field
+
+from ._base import StageConfig
+
+
+class DedupConfig(StageConfig):
+    """Two-stage duplicate removal."""
+
+    tau_dup: float = Field(0.5, ge=0, le=1, description="Stage 1: pairwise IoU >= this -> keep the larger part.")
+    tau_low: float = Field(0.2, ge=0, le=1, description="Stage 2: smaller parts with IoU >= this are cover candidates.")
+    cover_iou: float = Field(0.8, ge=0, le=1, description="Stage 2: remove a part whose candidates' union reaches this IoU.")
+    max_candidates: int = Field(16, ge=1, description="Stage 2 bound: consider at most this many candidates per part.")
+    tau_contained: float = Field(0.7, ge=0, le=1, description="Stage 3: remove a part with this share of its vertices inside one larger kept part (a fragment).")
+    fragment_share: float = Field(0.25, ge=0, le=1, description="Stage 4: a part at most this share of a larger kept part's size (vertices) ...")
+    footprint_margin_m: float = Field(0.01, ge=0, description="... with tau_contained of its points inside that part's box grown by this (m) is a sliver of it.")
