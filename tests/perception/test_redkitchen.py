@@ -43,8 +43,8 @@ def test_redkitchen_fronts_found_as_separate_parts(tmp_path, scene):
 
     On the 50 frames of ``--stride 5``, the view set the heuristic was tuned and documented on. The
     heuristic's RedKitchen result depends on the view set: 7-Scenes' colour frames are each misregistered
-    by their own amount, so the fused orthophotos differ (heuristic version 14, full pipeline: the default
-    keyframe selection keeps 119 frames and finds 5 / 3, against 7 / 1 for stride 5; README, Results)."""
+    by their own amount, so the fused orthophotos differ (full pipeline: the default keyframe selection
+    keeps 119 frames and finds 5 / 3, against 7 / 1 for stride 5; docs/results.md)."""
     out = tmp_path / "out"
     env = dict(os.environ, REACT3D_CACHE=str(tmp_path / "cache"))  # a cold cache: the run is the pipeline's
     proc = subprocess.run([sys.executable, "-m", "flows.cli", "convert", str(SCENE), "--out", str(out), "--stride", "5"],
