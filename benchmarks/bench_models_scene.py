@@ -177,7 +177,7 @@ def run_stage(perception: Any, frames: list[Any], cfg: Any, batch: int, workers:
 def per_call(perception: Any, frames: list[Any], batch: int, reps: int) -> dict[str, float]:
     """ms per frame of each model call, sequential, on ``reps`` batches of ``batch`` frames."""
     from react3d_core.scene_io.images import frame_rgb
-    from tasks.models.grounded_sam import QUERIES_PER_DETECTION, detect, sam_box_masks_batched, sam_image_embeddings, top_detections
+    from react3d_models.grounded_sam import QUERIES_PER_DETECTION, detect, sam_box_masks_batched, sam_image_embeddings, top_detections
 
     seg = perception.segmenter
     acc = {"read_jpeg": 0.0, "clip_tagger": 0.0, "grounding_dino": 0.0, "sam_encoder": 0.0, "sam_decoder_masks": 0.0}
@@ -210,7 +210,7 @@ def stock_models(paths: dict[str, Path], device: Any) -> tuple[Any, Any]:
     import torch
     from transformers import AutoProcessor, GroundingDinoForObjectDetection, SamModel, SamProcessor
 
-    from tasks.models.runtime import Loaded
+    from react3d_models.runtime import Loaded
 
     det = GroundingDinoForObjectDetection.from_pretrained(str(paths["detector"])).to(device).eval()
     sam = SamModel.from_pretrained(str(paths["sam"])).to(device).eval()
@@ -223,7 +223,7 @@ def stock_detect(det: Any, image: Any, box_t: float, text_t: float) -> Any:
     model's output tensors (on the GPU when the model is there)."""
     import torch
 
-    from tasks.models.grounded_sam import detections_from_outputs, detector_prompt
+    from react3d_models.grounded_sam import detections_from_outputs, detector_prompt
 
     inputs = det.processor(images=[image], text=[detector_prompt(PHRASES)], return_tensors="pt").to(det.device)
     with torch.inference_mode():
@@ -238,7 +238,7 @@ def reference(paths: dict[str, Path], frames: list[Any], n: int, device: Any, bo
     import torch
 
     from react3d_core.scene_io.images import frame_rgb
-    from tasks.models.grounded_sam import sam_box_masks, sam_image_embeddings, top_detections
+    from react3d_models.grounded_sam import sam_box_masks, sam_image_embeddings, top_detections
 
     saved = os.environ.get("TRANSFORMERS_DISABLE_TORCH_CHECK")
     os.environ["TRANSFORMERS_DISABLE_TORCH_CHECK"] = "0"
@@ -325,12 +325,12 @@ def main(argv: list[str] | None = None) -> int:
     from rich.console import Console
 
     from react3d_core.config import PerceptionConfig
-    from tasks.models import make_model_perception
-    from tasks.models.random_checkpoints import save_random_checkpoints
-    from tasks.models.runtime import clear_cache
+    from react3d_models import make_model_perception
+    from react3d_models.random_checkpoints import save_random_checkpoints
+    from react3d_models.runtime import clear_cache
 
     if a.plain_mask_copy:
-        from tasks.models import grounded_sam
+        from react3d_models import grounded_sam
 
         grounded_sam.masks_to_host = lambda m: m.cpu().numpy()  # type: ignore[assignment]
     gpu = torch.cuda.is_available()

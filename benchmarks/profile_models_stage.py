@@ -126,8 +126,8 @@ def main(argv: list[str] | None = None) -> int:
     import transformers
 
     from react3d_core.config import PerceptionConfig
-    from tasks.models import make_model_perception
-    from tasks.models.random_checkpoints import save_random_checkpoints
+    from react3d_models import make_model_perception
+    from react3d_models.random_checkpoints import save_random_checkpoints
 
     transformers.utils.logging.disable_progress_bar()
     gpu = torch.cuda.is_available()

@@ -37,7 +37,7 @@ def model_backend_version(config: dict[str, Any]) -> dict[str, str]:
     """The model backend's version, when the config uses it (its module imports nothing heavy)."""
     if (config.get("perception") or {}).get("backend") != "models":
         return {}
-    from tasks.models.version import STAGE_VERSION
+    from react3d_models.version import STAGE_VERSION
 
     return {"tasks.models": STAGE_VERSION}
 

@@ -33,7 +33,7 @@ def get_perception(scene: SceneInput, cfg: PerceptionConfig) -> Perception:
     with _BUILD_LOCK:
         if key not in _BACKENDS:
             if cfg.backend == "models":
-                from tasks.models import make_model_perception
+                from react3d_models import make_model_perception
 
                 _BACKENDS[key] = make_model_perception(cfg)
             else:

@@ -86,8 +86,8 @@ class _Recorder(BaseHTTPRequestHandler):
 
 def test_keys_come_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("torch")
-    from tasks.models.opdmulti import OPDMultiClient
-    from tasks.models.runtime import api_key
+    from react3d_models.opdmulti import OPDMultiClient
+    from react3d_models.runtime import api_key
 
     monkeypatch.delenv("REACT3D_OPDMULTI_API_KEY_BLOCK", raising=False)
     monkeypatch.setenv("REACT3D_OPDMULTI_API_KEY", SECRET)
@@ -109,7 +109,7 @@ SECRET_BLOCK = """
 import os, sys
 from prefect.blocks.system import Secret
 from prefect.testing.utilities import prefect_test_harness
-from tasks.models.runtime import api_key
+from react3d_models.runtime import api_key
 with prefect_test_harness(server_startup_timeout=300):
     Secret(value=sys.argv[1]).save("react3d-opdmulti-key")
     os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "react3d-opdmulti-key"

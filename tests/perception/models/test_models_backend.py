@@ -11,10 +11,10 @@ import torch
 from react3d_core.config import PerceptionConfig
 from react3d_core.perception.interfaces import (ArticulationPredictor, PointPromptSegmenter, Tagger, TagFilter,
                                                 TextPromptSegmenter)
-from tasks.models import STAGE_VERSION, ModelUnavailableError, make_model_perception
-from tasks.models.options import ModelOptions, model_options
-from tasks.models.runtime import cached_keys, resolve_device, resolve_dtype
-from tasks.models.tagger import select_tags
+from react3d_models import STAGE_VERSION, ModelUnavailableError, make_model_perception
+from react3d_models.options import ModelOptions, model_options
+from react3d_models.runtime import cached_keys, resolve_device, resolve_dtype
+from react3d_models.tagger import select_tags
 
 
 def _chat(i, body):
@@ -155,8 +155,8 @@ def test_local_lm_tag_filter_path(tmp_path):
     unreadable, so only 'door' survives (the documented fallback)."""
     import transformers as tf
 
-    from tasks.models.loaders import load_causal_lm
-    from tasks.models.tag_filter import CachedTagFilter, local_lm_asker
+    from react3d_models.loaders import load_causal_lm
+    from react3d_models.tag_filter import CachedTagFilter, local_lm_asker
 
     words = "[PAD] [UNK] [CLS] [SEP] [MASK] . [ ] , cabinet door drawer table".split()
     torch.manual_seed(0)

@@ -9,9 +9,9 @@ import torch
 
 from react3d_core.config import PerceptionConfig
 from react3d_core.pipeline.steps import split_on_oom
-from tasks.models import make_model_perception
-from tasks.models.grounded_sam import masks_to_original
-from tasks.models.runtime import preprocess
+from react3d_models import make_model_perception
+from react3d_models.grounded_sam import masks_to_original
+from react3d_models.runtime import preprocess
 
 pytestmark = [pytest.mark.gpu, pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device")]
 

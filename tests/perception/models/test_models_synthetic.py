@@ -10,7 +10,7 @@ import pytest
 from react3d_core.config import PerceptionConfig
 from react3d_core.scene_io import load_scene
 from react3d_core.scene_io.images import frame_rgb
-from tasks.models import make_model_perception
+from react3d_models import make_model_perception
 
 
 @pytest.mark.slow
