@@ -307,7 +307,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--frames", type=int, default=300)
     p.add_argument("--width", type=int, default=1920)
     p.add_argument("--height", type=int, default=1440)
-    p.add_argument("--batch", type=int, default=8, help="frames per perceive() call (perception.batch_size)")
+    p.add_argument("--batch", type=int, default=8, help="frames per perceive() call and per model forward (perception.batch_size, perception.models.batch_size)")
     p.add_argument("--workers", type=int, default=4, help="threads running perceive() (the flow runs 4)")
     p.add_argument("--subset", type=int, default=64, help="frames for the variants and the out-of-memory check")
     p.add_argument("--ref-frames", type=int, default=3)
@@ -362,14 +362,14 @@ def main(argv: list[str] | None = None) -> int:
     frames = write_frames(work / "frames", a.frames, a.width, a.height)
     result["write_frames_s"] = time.perf_counter() - t0
     srv, url = chat_server()
-    cfg = PerceptionConfig(backend="models", detector_model=str(paths["detector"]), sam_model=str(paths["sam"]),
-                           tagger_model=str(paths["clip"]), tag_filter_endpoint=url, box_threshold=a.box_threshold,
-                           batch_size=a.batch, device=str(device))
+    cfg = PerceptionConfig(backend="models", batch_size=a.batch, models=dict(
+        detector_model=str(paths["detector"]), sam_model=str(paths["sam"]), tagger_model=str(paths["clip"]),
+        tag_filter_endpoint=url, box_threshold=a.box_threshold, max_detections=a.max_detections, batch_size=a.batch,
+        device=str(device)))
 
     t, perception = timed(lambda: make_model_perception(cfg))
     result["load_models_s"] = t
     save()
-    perception.segmenter.max_detections = a.max_detections
     con.print(f"[bold]models loaded in {t:.1f} s; {a.frames} frames {a.width}x{a.height}")
     sub = frames[: max(2, min(a.subset, len(frames)))]
     run_stage(perception, frames[: a.batch], cfg, a.batch, 1)  # warm-up
@@ -382,9 +382,9 @@ def main(argv: list[str] | None = None) -> int:
     else:
         variants(result, runs, perception, frames, sub, cfg, a, paths, device, gpu, save)
     result["ref_fp32_b1_forward_s_per_frame"] = reference(paths, frames, 2 * a.ref_frames, device, a.box_threshold,
-                                                          cfg.text_threshold, a.max_detections, rebuild=False)
+                                                          cfg.models.text_threshold, a.max_detections, rebuild=False)
     result["ref_fp32_b1_rebuild_s_per_frame"] = reference(paths, frames, a.ref_frames, device, a.box_threshold,
-                                                          cfg.text_threshold, a.max_detections, rebuild=True)
+                                                          cfg.models.text_threshold, a.max_detections, rebuild=True)
     ours_pf = runs["ours"]["seconds"] / runs["ours"]["frames"]
     result["speedup_vs_ref_forward"] = result["ref_fp32_b1_forward_s_per_frame"] / ours_pf
     result["speedup_vs_ref_rebuild"] = result["ref_fp32_b1_rebuild_s_per_frame"] / ours_pf

@@ -39,7 +39,7 @@ def model_backend_version(config: dict[str, Any]) -> dict[str, str]:
         return {}
     from react3d_models.version import STAGE_VERSION
 
-    return {"tasks.models": STAGE_VERSION}
+    return {"react3d_models": STAGE_VERSION}
 
 
 def step_key(step: str, params: dict[str, Any], extra_versions: ExtraVersions | None = None,

@@ -58,7 +58,7 @@ def _env(tmp_path: Path, hub: str, offline: bool) -> dict[str, str]:
 
 BUILD = ("from react3d_core.config import PerceptionConfig\n"
          "from react3d_models import make_model_perception\n"
-         "make_model_perception(PerceptionConfig(backend='models', device='cpu'))\n")
+         "make_model_perception(PerceptionConfig(backend='models', models={'device': 'cpu'}))\n")
 
 
 @pytest.mark.parametrize("offline", [False, True], ids=["hub-silent", "HF_HUB_OFFLINE"])
@@ -105,5 +105,5 @@ def test_local_folder_is_found_without_the_hub(tmp_path: Path) -> None:
     (local / "config.json").write_text("{}")
     assert locally_available(str(local)) and hub_kwargs(str(local)) == {"local_files_only": True}
     check_models_available([ModelNeed("SAM", str(local), "sam_model")])  # no probe, no error
-    with pytest.raises(ModelUnavailableError, match="local folder does not exist.*perception.sam_model"):
+    with pytest.raises(ModelUnavailableError, match="local folder does not exist.*perception.models.sam_model"):
         check_models_available([ModelNeed("SAM", str(tmp_path / "typo"), "sam_model")])
