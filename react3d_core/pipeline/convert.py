@@ -63,8 +63,8 @@ def convert(scene_path: str | Path, out_dir: str | Path, config: PipelineConfig 
             perception: Perception | None = None, progress: ProgressFn | None = None) -> InteractiveScene:
     """Convert the scan at ``scene_path`` into ``out_dir``; returns the written manifest.
 
-    ``perception``: a backend to use (default: the weight-free one the config names; the ``models``
-    backend needs weights and is built by ``tasks.models.make_model_perception``)."""
+    ``perception``: a backend to use (default: the one the config names, built by
+    :func:`react3d_core.perception.make_perception`; ``models`` needs the ``react3d_models`` package)."""
     t_all = time.perf_counter()
     out = check_output_dir(out_dir, (str(scene_path),), kind=OUTPUT_KIND)  # before any stage runs
     cfg = config if isinstance(config, PipelineConfig) else PipelineConfig().with_overrides(config or {})

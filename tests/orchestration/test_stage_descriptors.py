@@ -84,7 +84,8 @@ def test_every_stage_package_declares_itself_and_the_manifest_versions_follow() 
 
 
 def test_perception_keys_name_the_model_backend_only_when_it_is_used() -> None:
-    """Workers with and without torch share heuristic keys; the key never imports the model code."""
+    """Workers with and without torch share heuristic keys; the key never imports torch, not even to name
+    the model backend's version."""
     import subprocess
     import sys
 
@@ -92,9 +93,10 @@ def test_perception_keys_name_the_model_backend_only_when_it_is_used() -> None:
 
     assert model_backend_version(BASE) == {}
     models = {**BASE, "perception": {**BASE["perception"], "backend": "models"}}
-    assert model_backend_version(models) == {"tasks.models": "2"}
-    code = ("import sys; from tasks.perception import perceive_frames; from tasks.keys import step_key; "
+    assert model_backend_version(models) == {"react3d_models": "3"}
+    code = ("import sys; from tasks.perception import perceive_frames; from tasks.keys import step_key, model_backend_version; "
             "from react3d_core.config import PipelineConfig; "
-            "step_key('perception', {'config': PipelineConfig().model_dump(mode='json')}); print('torch' in sys.modules)")
+            "step_key('perception', {'config': PipelineConfig().model_dump(mode='json')}); "
+            "model_backend_version({'perception': {'backend': 'models'}}); print('torch' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.stdout.strip().splitlines()[-1] == "False", out.stderr[-1500:]

@@ -100,12 +100,12 @@ def chat_url(endpoint: str) -> str:
 
 
 def chat_asker(endpoint: str, model: str, timeout_s: float, retries: int, backoff_s: float,
-               api_key: str | None = None) -> Callable[[list[str]], str | None]:
+               api_key: str | None = None, max_tokens: int = 512) -> Callable[[list[str]], str | None]:
     """ask() for an OpenAI-compatible endpoint: retries transport errors/5xx/429 with backoff, then raises."""
     url = chat_url(endpoint)
 
     def ask(tags: list[str]) -> str | None:
-        body = json.dumps({"model": model, "temperature": 0, "max_tokens": 512, "messages": [
+        body = json.dumps({"model": model, "temperature": 0, "max_tokens": max_tokens, "messages": [
             {"role": "system", "content": SYSTEM_PROMPT}, {"role": "user", "content": filter_prompt(tags)}]}).encode()
         headers = {"Content-Type": "application/json"}
         if api_key:

@@ -22,6 +22,8 @@ from react3d_core.errors import ConfigError
 
 log = logging.getLogger(__name__)
 
+SECTION = "perception.models"  # where the settings named in error messages live
+
 _DTYPES = {"fp32": torch.float32, "float32": torch.float32, "fp16": torch.float16, "float16": torch.float16,
            "bf16": torch.bfloat16, "bfloat16": torch.bfloat16}
 _CACHE: dict[tuple[str, str, str, str], Any] = {}
@@ -38,7 +40,7 @@ def resolve_device(device: str) -> torch.device:
         return torch.device("cuda" if torch.cuda.is_available() else "cpu")
     dev = torch.device(device)
     if dev.type == "cuda" and not torch.cuda.is_available():
-        raise ConfigError(f"perception.device={device!r} but no CUDA GPU is visible; use 'auto' or 'cpu'")
+        raise ConfigError(f"{SECTION}.device={device!r} but no CUDA GPU is visible; use 'auto' or 'cpu'")
     return dev
 
 
@@ -71,7 +73,7 @@ def missing_weights_message(what: str, model_id: str, config_field: str, cause: 
         f"{what} weights could not be loaded from {where} {model_id!r}{offline}: {type(cause).__name__}: "
         f"{str(cause).splitlines()[0][:200] if str(cause) else ''}. Fix: `huggingface-cli download {model_id}` "
         f"on a machine with internet (cache: $HF_HOME, default ~/.cache/huggingface), or save the model with "
-        f"save_pretrained() to a folder and set perception.{config_field} to that path."
+        f"save_pretrained() to a folder and set {SECTION}.{config_field} to that path."
     )
 
 
@@ -162,7 +164,7 @@ HUB_PROBE_TIMEOUT_S = 3.0
 
 @dataclass(frozen=True)
 class ModelNeed:
-    """One model the backend will load: what it is, its hub id or folder, and the config field naming it."""
+    """One model the backend will load: what it is, its hub id or folder, and the field of perception.models naming it."""
 
     what: str
     model_id: str
@@ -239,13 +241,13 @@ def check_models_available(needs: list[ModelNeed]) -> None:
     else:
         log.warning("downloading %s from %s", ", ".join(n.model_id for n in missing), hub_endpoint())
         return
-    names = "; ".join(f"{n.what} {n.model_id!r} (perception.{n.config_field})" for n in missing)
+    names = "; ".join(f"{n.what} {n.model_id!r} ({SECTION}.{n.config_field})" for n in missing)
     ids = " ".join(n.model_id for n in missing if not _looks_like_path(n.model_id))
     raise ModelUnavailableError(
         f"model weights not available on this machine ({why}): {names}. Fix: "
         + (f"`huggingface-cli download {ids}` (each id) on a machine with internet and copy the cache "
            f"($HF_HOME, default ~/.cache/huggingface), or " if ids else "")
-        + "save each model with save_pretrained() to a folder and set the perception field to that path.")
+        + f"save each model with save_pretrained() to a folder and set the {SECTION} field to that path.")
 
 
 def api_key(env_vars: tuple[str, ...], secret_block_var: str) -> str | None:

@@ -179,6 +179,6 @@ class NoArticulationPredictor:
 
     def predict(self, frames: Sequence[Frame], images: Sequence[np.ndarray]) -> list[list[ArticulationPrediction]]:
         if not self._warned:
-            log.warning("perception.articulation_endpoint is not set: no OPDMulti predictions (see docs/perception_models.md)")
+            log.warning("perception.models.articulation_endpoint is not set: no OPDMulti predictions (see docs/perception_models.md)")
             self._warned = True
         return [[] for _ in frames]
