@@ -33,7 +33,7 @@ def score_scene(scene_dir: str, overrides: dict[str, Any]) -> dict[str, Any]:
     from react3d_core.ground_truth.articulate3d import read_articulate3d
     from react3d_core.metrics.front_match import match_fronts
     from react3d_core.perception.heuristic import HeuristicModel
-    from react3d_core.scene_io.loaders import load_scene
+    from react3d_core.scene_io import load_scene
 
     t0 = time.perf_counter()
     d = Path(scene_dir)
