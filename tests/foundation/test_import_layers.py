@@ -61,3 +61,16 @@ def test_the_walk_covers_the_packages() -> None:
     """Guards the test itself: the packages are where it looks, and the CLI's command table is seen."""
     assert all(len(list((ROOT / p).rglob("*.py"))) > 5 for p in PACKAGES)
     assert any(top == "flows" for _, top in imported_packages(ROOT / "flows" / "cli.py"))
+
+
+def test_prefect_artifacts_are_made_in_one_module() -> None:
+    """What the Prefect UI shows of a run (progress, summaries, tables, links) is made in flows/artifacts.py."""
+    users = set()
+    for package in PACKAGES:
+        for path in (ROOT / package).rglob("*.py"):
+            for node in ast.walk(ast.parse(path.read_text())):
+                names = ([a.name for a in node.names] if isinstance(node, ast.Import)
+                         else [node.module or ""] if isinstance(node, ast.ImportFrom) else [])
+                if any(n == "prefect.artifacts" or n.startswith("prefect.artifacts.") for n in names):
+                    users.add(path.relative_to(ROOT).as_posix())
+    assert users == {"flows/artifacts.py"}
