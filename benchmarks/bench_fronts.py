@@ -4,7 +4,7 @@ the fronts it finds against the ground-truth parts, per scene and in total.
     python3 benchmarks/bench_fronts.py --scenes tuning_realistic_2 [--heuristic '{"protrusion_from_surface": true}'] \
         [--out /tmp/fronts] [--jobs 2] [--json F]
 
-``--scenes`` is a set (benchmarks/sets/NAME.json; missing scenes are generated under ``--out``) or a glob
+``--scenes`` is a set (flows/bench/sets/NAME.json; missing scenes are generated under ``--out``) or a glob
 of scene folders. Matching: ``react3d_core.metrics.front_match`` (area IoU >= 0.5, one-to-one); a front
 with a joint counts as typed right when its joint type is the part's. Minutes per set where the full
 ``react3d bench`` takes an hour, for deciding thresholds on the tuning sets; report with the full bench.
@@ -27,13 +27,13 @@ sys.path.insert(0, str(ROOT))
 
 def score_scene(scene_dir: str, overrides: dict[str, Any]) -> dict[str, Any]:
     """Build the heuristic on one scene folder (stride 1, as ``react3d bench``) and score its fronts."""
-    from benchmarks.miss_causes import gt_part_faces
-    from benchmarks.runner import _gt_dir
+    from flows.bench.miss_causes import gt_part_faces
+    from flows.bench.runner import _gt_dir
     from react3d_core.config import PipelineConfig
     from react3d_core.ground_truth.articulate3d import read_articulate3d
     from react3d_core.metrics.front_match import match_fronts
     from react3d_core.perception.heuristic import HeuristicModel
-    from react3d_core.scene_io.loaders import load_scene
+    from react3d_core.scene_io import load_scene
 
     t0 = time.perf_counter()
     d = Path(scene_dir)
@@ -52,7 +52,7 @@ def score_scene(scene_dir: str, overrides: dict[str, Any]) -> dict[str, Any]:
 
 
 def _scene_dirs(spec: str, out: Path) -> list[str]:
-    from benchmarks.runner import ensure_scene, load_spec
+    from flows.bench.runner import ensure_scene, load_spec
 
     return [str(ensure_scene(e)) for e in load_spec(spec, out)]
 

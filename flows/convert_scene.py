@@ -26,8 +26,10 @@ from react3d_core.pipeline import OUTPUT_KIND, ProgressFn, StageClock, manifest_
 from tasks import storage  # noqa: E402
 from tasks.articulation import articulate_part  # noqa: E402
 from tasks.assembly import assemble, export, stage_output  # noqa: E402
+from tasks.evaluation import evaluate  # noqa: E402
+from tasks.manifest import finalize  # noqa: E402
 from tasks.perception import perceive_frames  # noqa: E402
-from tasks.report import evaluate, finalize, report  # noqa: E402
+from tasks.report import report  # noqa: E402
 from tasks.scene import fingerprint_scene  # noqa: E402
 from tasks.segmentation import segment_scene  # noqa: E402
 

@@ -110,7 +110,7 @@ def test_dataset_run_isolates_a_corrupt_scene(scene: Path, tmp_path: Path) -> No
 
 
 def test_cold_cache_recomputes_and_leaves_a_self_contained_result(scene: Path, tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
-    from benchmarks.runner import cold_cache
+    from flows.bench.runner import cold_cache
     from tasks.store import cache_root
 
     cfg = {**CFG, "perception": {"backend": "oracle", "oracle": {"seed": 14}}, "export": {"formats": []}}

@@ -208,7 +208,7 @@ def test_canonical_mesh_ignores_input_order() -> None:
 
 
 def test_bench_sets_pass_scan_options() -> None:
-    from benchmarks.runner import load_spec
+    from flows.bench.runner import load_spec
 
     heldout = load_spec("heldout", Path("/nonexistent"))
     assert heldout[0]["name"] == "procedural_kitchen_100" and heldout[0]["synth"] == {}

@@ -1,4 +1,5 @@
-"""Report writers: per-part parquet and a markdown table laid out like the paper's tables."""
+"""The metric tables of ``react3d evaluate --out``: per-part and per-scene parquet, and metrics.md laid out
+like the paper's tables. (The per-scene ``report.html`` is the viewer's: ``react3d_core.viewer.report``.)"""
 
 from __future__ import annotations
 
@@ -62,7 +63,7 @@ def markdown_table(result: dict[str, Any], method: str = "REACT3D") -> str:
     return "\n".join(lines) + "\n"
 
 
-def write_report(out_dir: str | Path, scenes: list[SceneMetrics], method: str = "REACT3D") -> dict[str, Path]:
+def write_tables(out_dir: str | Path, scenes: list[SceneMetrics], method: str = "REACT3D") -> dict[str, Path]:
     """parts.parquet, scenes.parquet and metrics.md in ``out_dir``."""
     out_dir = Path(out_dir)
     return {

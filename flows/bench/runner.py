@@ -2,7 +2,7 @@
 and evaluate a benchmark set (docs/evaluation.md).
 
 Each scene runs in a fresh spawned process so its peak RSS is its own (ru_maxrss never goes down).
-Set files ship with the package (``benchmarks/sets/*.json``), so a non-editable install finds them too.
+Set files ship with the package (``flows/bench/sets/*.json``), so a non-editable install finds them too.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from typing import Any
 
 from react3d_core.errors import InputError
 
-SETS_DIR = Path(str(resources.files("benchmarks") / "sets"))
+SETS_DIR = Path(str(resources.files("flows.bench") / "sets"))
 
 
 def load_spec(spec: str, out_dir: Path, frames: int | None = None) -> list[dict[str, Any]]:
@@ -95,7 +95,7 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
     """Child-process body: generate if missing, convert (timed), return timings and peak RSS.
 
     ``cold``: a scratch folder; the conversion then starts from an empty cache (see :func:`cold_cache`).
-    ``miss_causes``: also attribute each missed / mis-jointed GT part to a stage (benchmarks.miss_causes), after
+    ``miss_causes``: also attribute each missed / mis-jointed GT part to a stage (flows.bench.miss_causes), after
     the timings and peak memory are taken.
     """
     scene_dir = ensure_scene(entry)
@@ -109,7 +109,7 @@ def run_one(entry: dict[str, Any], result_dir: str, config: dict[str, Any], cold
         out = {"manifest": str(manifest), "wall_s": wall, "peak_rss_mb": _peak_rss_mb(), "rss_before_mb": rss0}
         if miss_causes:
             try:
-                from benchmarks.miss_causes import trace_scene
+                from .miss_causes import trace_scene
 
                 out["miss_causes"] = trace_scene(str(scene_dir), str(manifest), config)
             except Exception as exc:  # noqa: BLE001 - a failed breakdown must not fail the scene's scores
