@@ -1,7 +1,7 @@
 """Front-level score of the heuristic perception step (no segmentation, articulation or export):
 the fronts it finds against the ground-truth parts, per scene and in total.
 
-    python3 benchmarks/bench_fronts.py --scenes tuning_realistic_2 [--heuristic '{"protrusion_from_surface": true}'] \
+    python3 benchmarks/bench_fronts.py --scenes tuning_realistic_2 [--heuristic '{"handles": {"protrusion_from_surface": true}}'] \
         [--out /tmp/fronts] [--jobs 2] [--json F] [--dump DIR]
 
 ``--scenes`` is a set (benchmarks/sets/NAME.json; missing scenes are generated under ``--out``) or a glob
