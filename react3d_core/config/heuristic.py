@@ -402,8 +402,8 @@ class HeuristicConfig(StageConfig):
     def _renamed_keys(cls, data: Any) -> Any:
         """A key of the earlier flat layout gets its new name in the error, not just 'extra forbidden'."""
         if isinstance(data, dict):
-            for old, new in RENAMED.items():
-                # 'splashback' and 'room_wall' are sections now: only their old boolean form is the old key
-                if old in data and not (old in cls.model_fields and isinstance(data[old], dict | StageConfig)):
-                    raise ValueError(f"perception.heuristic.{old} is now perception.heuristic.{new}")
+            # 'splashback' and 'room_wall' are sections now: only their old boolean form is the old key
+            old = [k for k in RENAMED if k in data and not (k in cls.model_fields and isinstance(data[k], dict | StageConfig))]
+            if old:
+                raise ValueError("; ".join(f"perception.heuristic.{k} is now perception.heuristic.{RENAMED[k]}" for k in old))
         return data
