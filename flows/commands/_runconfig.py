@@ -146,10 +146,14 @@ def run_with_progress(scene: str, out: str, cfg: dict[str, Any], title: str) -> 
     """Run the convert flow with a rich progress bar (one row per stage)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from flows import local_server
     from tasks import prefect_env
 
     prefect_env.configure()
+    local_server.attach()  # a server that has to start does so while the flow's modules load
     import flows.convert_scene as cs
+
+    local_server.ready()
 
     with Progress(TextColumn("[bold]{task.description:<13}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   transient=False) as bar:
