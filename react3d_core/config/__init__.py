@@ -25,6 +25,7 @@ from .fusion import ClipConfig, FusionConfig, TopKConfig
 from .heuristic import FrontRulesConfig, HeuristicConfig
 from .metrics import EvaluationConfig
 from .perception import OracleNoiseConfig, PerceptionConfig
+from .physics import PhysicsConfig
 from .scene_io import FrameSelectionConfig
 
 
@@ -42,6 +43,7 @@ class PipelineConfig(StageConfig):
     dedup: DedupConfig = Field(default_factory=DedupConfig, description="Duplicate part removal.")
     assembly: AssemblyConfig = Field(default_factory=AssemblyConfig, description="Carving the background.")
     export: ExportConfig = Field(default_factory=ExportConfig, description="What the exporters write.")
+    physics: PhysicsConfig = Field(default_factory=PhysicsConfig, description="The physics check run after the export.")
     evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig, description="Evaluation protocol thresholds.")
 
     def with_overrides(self, overrides: dict) -> "PipelineConfig":
@@ -92,6 +94,7 @@ __all__ = [
     "LimitConfig",
     "OracleNoiseConfig",
     "PerceptionConfig",
+    "PhysicsConfig",
     "PipelineConfig",
     "StageConfig",
     "TopKConfig",
