@@ -45,7 +45,8 @@ def run(args: argparse.Namespace) -> int:
     err = Console(stderr=True)
     with err.status("physics check") as status:
         check = check_output(root, cfg, engines, progress=lambda e, what: status.update(f"{e}: {what}"))
-    render(check, Console())
+    console = Console()
+    render(check, console if console.is_terminal else Console(width=200))  # a log or pipe keeps whole names
     write_check(check, target)
     print(f"json: {target}")
     return 1 if args.strict and not check.passed else 0

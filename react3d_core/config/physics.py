@@ -37,7 +37,7 @@ class PhysicsConfig(StageConfig):
     contact_hz: float = Field(100.0, gt=0, description="Contacts are read at this rate (every step if the step is longer).")
     probe_radius_m: float = Field(0.03, gt=0, description="Probe sphere radius (shrunk to 15 % of a small cavity's smallest side).")
     probe_mass_kg: float = Field(0.1, gt=0, description="Probe sphere mass.")
-    probe_speed: float = Field(1.0, gt=0, description="Speed at which the front probe is thrown at a closed front (m/s).")
+    probe_speed: float = Field(0.5, gt=0, description="Speed at which the front probe is pushed at a closed front (m/s), a gripper's approach.")
     cavity_probe_s: float = Field(1.0, gt=0, description="Time the cavity probe is left to fall and settle (s).")
     front_probe_s: float = Field(0.4, gt=0, description="Time the front probe flies and bounces (s).")
 

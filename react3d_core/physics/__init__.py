@@ -2,7 +2,7 @@
 
 Each joint alone is driven to its limit and back under a PD position controller; how far it got, how
 deep it pressed into other bodies and what it touched are recorded, with instabilities; a probe sphere
-is dropped into each open cavity (must fall in freely) and thrown at each closed front (must be
+is dropped into each open cavity (must fall in freely) and pushed against each closed front (must be
 blocked). ``check_output(out)`` runs it on a conversion's output; simulators are imported only when
 used, and a missing one is skipped with the reason. Definitions: docs/physics.md.
 """

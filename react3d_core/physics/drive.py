@@ -268,9 +268,9 @@ def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
 
 
 def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
-    """Every joint held at 0; a sphere (gravity compensated) thrown at the front's centre. Blocked: placed
+    """Every joint held at 0; a sphere (gravity compensated) pushed at the front's centre. Blocked: placed
     clear of every collider, the first body it touches is the front's link, and its leading point never
-    gets more than ``max_penetration_m`` past the front's outer face."""
+    gets more than ``max_penetration_m`` past the front's back face (into the cavity)."""
     j = sim.joints[i]
     plan = front_probe(f, cfg.probe_radius_m, cfg.probe_speed)
     q = np.zeros(len(sim.joints))
@@ -292,7 +292,7 @@ def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
         cause = "probe state not finite"
     elif adv > cfg.max_penetration_m:
         first = f"; first touched {touched[0].body}" if touched else "; touched nothing"
-        cause = f"passed through the front: {100 * adv:.1f} cm past its outer face{first}"
+        cause = f"passed through the front: {100 * adv:.1f} cm past its back face{first}"
     elif not touched:
         cause = "touched nothing"
     elif touched[0].body != j.link:

@@ -68,7 +68,7 @@ class JointCheck(BaseModel):
 
 
 class ProbeCheck(BaseModel):
-    """A sphere dropped into an open cavity (must be free) or thrown at a closed front (must be blocked)."""
+    """A sphere dropped into an open cavity (must be free) or pushed against a closed front (must be blocked)."""
 
     kind: Literal["cavity", "front"]
     object_id: str
@@ -78,7 +78,7 @@ class ProbeCheck(BaseModel):
     end: Vec3
     spawn_depth: float = Field(0.0, description="Penetration of the probe right after it was placed (m).")
     penetration: float = Field(0.0, description="Deepest penetration of the probe during the run (m).")
-    advance: float | None = Field(None, description="Front probe: deepest reach of its centre past the front's outer face, minus its radius (m; <= 0 stays outside).")
+    advance: float | None = Field(None, description="Front probe: deepest reach of its leading point past the front's back face (m; <= 0: never got through).")
     touched: list[Touch] = Field(default_factory=list, description="Bodies in order of first contact.")
     passed: bool
     cause: str | None = None

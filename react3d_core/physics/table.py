@@ -8,6 +8,9 @@ from typing import Any
 from .result import EngineCheck, PhysicsCheck
 
 
+KIND = {"revolute": "hinge", "prismatic": "slide"}
+
+
 def _cm(x: float | None) -> str:
     return "–" if x is None else f"{100 * x:.1f} cm"
 
@@ -49,7 +52,7 @@ def render(check: PhysicsCheck, console: Any = None, show_probes: bool = True) -
             continue
         for j in e.joints:
             verdict = "[green]pass[/]" if j.passed else "[red]FAIL[/] " + "; ".join(j.causes)
-            table.add_row(e.engine, j.joint, j.object_id or "–", j.joint_type[:4], f"{100 * j.reached:.0f} %",
+            table.add_row(e.engine, j.joint, j.object_id or "–", KIND[j.joint_type], f"{100 * j.reached:.0f} %",
                           "–" if j.time_to_reach is None else f"{j.time_to_reach:.2f} s", _cm(j.penetration),
                           touched_text(j.touched) or "–", verdict)
     console.print(table)

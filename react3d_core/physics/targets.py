@@ -142,14 +142,16 @@ class FrontProbe:
 
 
 def front_probe(f: Front, radius: float, speed: float, gap: float = 0.05) -> FrontProbe:
-    """A probe ``gap`` in front of the closed front's outer face (centre), thrown along ``n`` at ``speed``."""
+    """A probe ``gap`` in front of the closed front's outer face (centre), sent along ``n`` at ``speed``."""
     r = probe_radius(f, radius)
     return FrontProbe(f.outer - f.n * (r + gap), f.n * speed, r)
 
 
 def advance(f: Front, p: np.ndarray, r: float) -> float:
-    """How far the probe's leading point is past the front's outer face (m; <= 0: still outside)."""
-    return float(np.dot(np.asarray(p, float) - f.outer, f.n) + r)
+    """How far the probe's leading point is past the front's back face (m; <= 0: it has not got through
+    the front). The back face, not the outer one: a front's box includes its handles, and a scanned
+    front is an open sheet whose box ends at the panel."""
+    return float(np.dot(np.asarray(p, float) - f.back, f.n) + r)
 
 
 # ------------------------------------------------------------------ joints

@@ -80,7 +80,7 @@ def test_a_front_without_collider_lets_the_probe_through(frontless_out: Path, en
     e = run(frontless_out, engine)
     p = probes(e)[("front", "door")]
     assert not p.passed and p.cause.startswith("passed through the front")
-    assert p.advance is not None and p.advance > 0.1
+    assert p.advance is not None and p.advance > 0.05  # well into the cavity
     assert probes(e)[("front", "drawer")].passed
 
 

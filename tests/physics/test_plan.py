@@ -70,8 +70,9 @@ def test_front_probe_and_advance() -> None:
     plan = front_probe(f, 0.03, 1.0)
     np.testing.assert_allclose(plan.start, [-0.75, 0.47 - 0.08, 0.32])
     np.testing.assert_allclose(plan.velocity, [0, 1, 0])
-    assert advance(f, np.array([-0.75, 0.45, 0.32]), 0.03) == pytest.approx(0.01)
-    assert advance(f, plan.start, 0.03) == pytest.approx(-0.05)
+    # measured from the back face (y = 0.49): a front's box includes its handles
+    assert advance(f, np.array([-0.75, 0.47, 0.32]), 0.03) == pytest.approx(0.01)
+    assert advance(f, plan.start, 0.03) == pytest.approx(-0.07)
 
 
 def test_joints_match_by_geometry_whatever_their_names() -> None:
