@@ -107,7 +107,7 @@ def check_engine(engine: str, root: Path, scene: InteractiveScene, cfg: PhysicsC
         path = path.with_suffix(".urdf")
     if not path.is_file():
         return EngineCheck(engine=engine, status="error", reason=f"{path}: exported file is missing", file=scene.exports[fmt])
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     sim: Sim | None = None
     try:
         sim = _make(engine, path, cfg)
@@ -123,7 +123,7 @@ def check_engine(engine: str, root: Path, scene: InteractiveScene, cfg: PhysicsC
     finally:
         if sim is not None:
             sim.close()
-    out.seconds = time.perf_counter() - t0
+    out.seconds, out.cpu_seconds = time.perf_counter() - t0, time.process_time() - c0
     return out
 
 

@@ -91,7 +91,8 @@ class EngineCheck(BaseModel):
     reason: str | None = None
     file: str | None = Field(None, description="The exported file the engine loaded, relative to the output folder.")
     settings: dict[str, Any] = Field(default_factory=dict)
-    seconds: float = 0.0
+    seconds: float = Field(0.0, description="Wall-clock seconds: load and every episode.")
+    cpu_seconds: float = Field(0.0, description="CPU seconds of this process meanwhile (the cost on a busy machine).")
     rest: RestCheck | None = None
     joints: list[JointCheck] = Field(default_factory=list)
     probes: list[ProbeCheck] = Field(default_factory=list)
@@ -99,7 +100,7 @@ class EngineCheck(BaseModel):
     def summary(self, reach: float = 0.9) -> dict[str, Any]:
         """The numbers of the table's summary line (and of the manifest's ``physics`` key); ``reach``: the
         fraction of the upper limit counted as reached."""
-        out: dict[str, Any] = {"status": self.status, "seconds": round(self.seconds, 2)}
+        out: dict[str, Any] = {"status": self.status, "seconds": round(self.seconds, 2), "cpu_seconds": round(self.cpu_seconds, 2)}
         if self.status != "ok":
             out["reason"] = self.reason
             return out
