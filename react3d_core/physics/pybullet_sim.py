@@ -1,6 +1,7 @@
 """PyBullet: the exported URDF with a fixed base and self-collision on (``URDF_USE_SELF_COLLISION``:
 every pair of links collides except a child with its parent, PyBullet's default once self-collision is
-asked for), inertials from the file, the engine's default solver, gravity -9.81 m/s^2.
+asked for), inertials from the file, the engine's default solver, gravity -9.81 m/s^2. Pairs of links
+that never move (background, carcasses) are switched off: they cannot move anything.
 
 The default velocity motors PyBullet puts on every joint are switched off (force 0); the drive is the
 check's PD law applied as joint torques.
@@ -38,7 +39,7 @@ class PybulletSim(Sim):
         self.dt = float(timestep)
         params = pb.getPhysicsEngineParameters(physicsClientId=cid)
         self.settings = {"file": "URDF", "timestep": self.dt, "fixed_base": True,
-                         "self_collision": "on, parent-child pairs excluded (URDF_USE_SELF_COLLISION)",
+                         "self_collision": "on, parent-child pairs excluded (URDF_USE_SELF_COLLISION); pairs of links that never move skipped",
                          "solver_iterations": int(params.get("numSolverIterations", 0)), "gravity": [0, 0, -G],
                          "drive": "PD as joint torques (TORQUE_CONTROL), default motors off"}
         n = pb.getNumJoints(body, physicsClientId=cid)
@@ -74,6 +75,12 @@ class PybulletSim(Sim):
             return False
 
         self.moving = frozenset(self.link_names[i] for i in range(n) if moves(i))
+        # links that never move cannot push anything: their pairs are skipped, as MuJoCo skips bodies welded
+        # to the world (half of each step's cost on a kitchen: the background against every carcass)
+        still = [i for i in range(-1, n) if self.link_names[i] not in self.moving]
+        for k, a in enumerate(still):
+            for b in still[k + 1:]:
+                pb.setCollisionFilterPair(body, body, a, b, 0, physicsClientId=cid)
         self.kp = self.kd = np.zeros(len(self.idx))
         self.fmax = np.inf
         self.probe_id: int | None = None
