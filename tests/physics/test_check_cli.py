@@ -72,3 +72,18 @@ def test_report_shows_the_physics_section(clean_out: Path, tmp_path: Path) -> No
     record_physics(out / "scene.json", None, "RuntimeError: engine exploded")
     page = write_report(out / "scene.json", thumbnails=False).read_text()
     assert "Physics check: FAIL" in page and "engine exploded" in page
+
+
+def test_convert_flag_chooses_the_engines_or_none() -> None:
+    from flows.cli import build_parser
+    from flows.commands._runconfig import pipeline_overrides
+    from react3d_core.errors import ConfigError
+
+    def parse(*flag: str) -> dict:
+        return pipeline_overrides(build_parser().parse_args(["convert", "scene", "--out", "o", *flag]))
+
+    assert parse("--physics", "mujoco,SAPIEN")["physics"] == {"enabled": True, "engines": ["mujoco", "sapien"]}
+    assert parse("--physics", "none")["physics"] == {"enabled": False}
+    assert "physics" not in parse()
+    with pytest.raises(ConfigError, match="gazebo"):
+        parse("--physics", "mujoco,gazebo")
