@@ -96,15 +96,12 @@ def run_engine(sim: Sim, targets: list[Front], cfg: PhysicsConfig, progress: Pro
 
 def check_engine(engine: str, root: Path, scene: InteractiveScene, cfg: PhysicsConfig,
                  progress: ProgressFn | None = None) -> EngineCheck:
-    pkg = engine
-    if find_spec(pkg) is None:
-        return EngineCheck(engine=engine, status="skipped", reason=f"{pkg} is not installed ({INSTALL[engine]})")
+    if find_spec(engine) is None:  # each engine's package is named after it
+        return EngineCheck(engine=engine, status="skipped", reason=f"{engine} is not installed ({INSTALL[engine]})")
     fmt = FORMAT[engine]
     if fmt not in scene.exports:
         return EngineCheck(engine=engine, status="skipped", reason=f"the export has no {fmt.upper()} (export.formats)")
     path = root / scene.exports[fmt]
-    if fmt == "urdf" and path.suffix != ".urdf":
-        path = path.with_suffix(".urdf")
     if not path.is_file():
         return EngineCheck(engine=engine, status="error", reason=f"{path}: exported file is missing", file=scene.exports[fmt])
     t0, c0 = time.perf_counter(), time.process_time()
