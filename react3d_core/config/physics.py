@@ -34,12 +34,12 @@ class PhysicsConfig(StageConfig):
     max_speed_rad: float = Field(20.0, gt=0, description="Joint speed above this is a blow-up (rad/s).")
     max_speed_m: float = Field(5.0, gt=0, description="Joint speed above this is a blow-up (m/s).")
     timestep: float = Field(1 / 240, gt=0, le=0.02, description="PyBullet and SAPIEN time step (s); MuJoCo uses the MJCF's own.")
-    contact_hz: float = Field(100.0, gt=0, description="Contacts are read at this rate (every step if the step is longer).")
+    contact_hz: float = Field(100.0, gt=0, description="Contacts of a driven part are read at this rate (every step if the step is longer); a probe's every step.")
     probe_radius_m: float = Field(0.03, gt=0, description="Probe sphere radius (shrunk to 15 % of a small cavity's smallest side).")
     probe_mass_kg: float = Field(0.1, gt=0, description="Probe sphere mass.")
     probe_speed: float = Field(0.5, gt=0, description="Speed at which the front probe is pushed at a closed front (m/s), a gripper's approach.")
     cavity_probe_s: float = Field(1.0, gt=0, description="Time the cavity probe is left to fall and settle (s).")
-    front_probe_s: float = Field(0.4, gt=0, description="Time the front probe flies and bounces (s).")
+    front_probe_s: float = Field(0.4, gt=0, description="Time the front probe flies and bounces (s); longer for a deep front, so that an unhindered probe ends 5 cm past its back face.")
 
     @field_validator("engines")
     @classmethod

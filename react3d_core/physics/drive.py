@@ -218,16 +218,14 @@ def _probe_loop(sim: Sim, q_hold: np.ndarray, seconds: float, cfg: PhysicsConfig
     """Step with the joints held at ``q_hold``; returns the probe's contacts and how deep it was right
     after being placed (first step)."""
     log = ContactLog(frozenset({PROBE}))
-    every = _every(cfg, sim.dt)
     spawn = 0.0
     zeros = np.zeros_like(q_hold)
     for k in range(_steps(seconds, sim.dt)):
         sim.step(q_hold, zeros)
-        if k % every == 0:
-            cs = sim.contacts(log.watch)
-            if k == 0:
-                spawn = max((max(0.0, -c.dist) for c in cs), default=0.0)
-            log.add(cs)
+        cs = sim.contacts(log.watch)  # every step: a bounce lasts one or two
+        if k == 0:
+            spawn = max((max(0.0, -c.dist) for c in cs), default=0.0)
+        log.add(cs)
         if track is not None:
             track(sim.probe()[0])
     return log, spawn
@@ -268,7 +266,8 @@ def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
 
 
 def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
-    """Every joint held at 0; a sphere (gravity compensated) pushed at the front's centre. Blocked: placed
+    """Every joint held at 0; a sphere (gravity compensated) pushed at the front's centre, for ``front_probe_s``
+    or longer when the front is deep (an unhindered probe ends 5 cm past its back face). Blocked: placed
     clear of every collider, the first body it touches is the front's link, and its leading point never
     gets more than ``max_penetration_m`` past the front's back face (into the cavity)."""
     j = sim.joints[i]
@@ -281,7 +280,9 @@ def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
     def track(p: np.ndarray) -> None:
         deepest[0] = max(deepest[0], advance(f, p, plan.radius))
 
-    log, spawn = _probe_loop(sim, q, cfg.front_probe_s, cfg, track)
+    # long enough for an unhindered probe to end 5 cm past the back face, whatever the front's depth
+    seconds = max(cfg.front_probe_s, (float(np.dot(f.back - plan.start, f.n)) + 0.05) / cfg.probe_speed + 0.1)
+    log, spawn = _probe_loop(sim, q, seconds, cfg, track)
     end = sim.probe()[0]
     adv = float(deepest[0]) if np.isfinite(deepest[0]) else None  # None: the probe's state was not finite
     touched = log.touches(by_depth=False)
