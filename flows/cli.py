@@ -18,6 +18,7 @@ COMMANDS: dict[str, str] = {
     "evaluate": "flows.commands.evaluate",
     "bench": "flows.commands.bench",
     "export": "flows.commands.export",
+    "check": "flows.commands.check",
     "view": "flows.commands.view",
     "cache": "flows.commands.cache",
     "server": "flows.commands.server",
