@@ -29,6 +29,7 @@ from .orthophoto import Orthophoto
 _NEAR = 0.1  # m: plane points closer to the camera than this are at or behind it
 _SAMPLES_PER_PX = 2  # a segment is followed at half a grid pixel on the plane ...
 _MAX_SAMPLES = 4096  # ... with at most this many samples (a segment seen nearly edge-on spans metres)
+_COARSE = 32  # points along a segment on which its piece over a plane's grid is found
 _PICK_GRID = 5  # views are scored on this many x this many points of a plane
 _SIDES = (-1.0, 0.0, 1.0)  # a sample is on the plane when the rays through it and beside it all are
 _XY = 2  # coordinates of an image point
@@ -96,6 +97,29 @@ def _samples(seg: np.ndarray, plane_len: np.ndarray, depth_ratio: np.ndarray, re
     return x, y, idx
 
 
+def _within_grid(seg: np.ndarray, flag: np.ndarray, f: Frame, width: int, height: int, c: ColourCalibration,
+                 o: Orthophoto) -> tuple[np.ndarray, np.ndarray]:
+    """The pieces of image segments (N, 4) whose points land on ``o``'s grid (found on ``_COARSE`` points
+    along each, widened by one step), with their ``flag``; segments missing the grid are dropped. A floor
+    line carried onto a wall plane lands metres away: it is not followed there."""
+    a = np.linspace(0.0, 1.0, _COARSE)
+    x = seg[:, [0]] + a * (seg[:, [2]] - seg[:, [0]])
+    y = seg[:, [1]] + a * (seg[:, [3]] - seg[:, [1]])
+    dirs, t = rays_to_plane(normalised_coords(x, y, f, width, height, c), f.c2w, o.plane.n, o.plane.d)
+    p = f.c2w[:3, 3] + dirs * t[..., None]
+    H, W = o.n_views.shape
+    col, row = (p @ o.plane.u - o.u0) / o.res, (o.v_top - p[..., 2]) / o.res
+    with np.errstate(invalid="ignore"):
+        on = np.isfinite(t) & (col > -1) & (col < W + 1) & (row > -1) & (row < H + 1)
+    keep = on.any(1)
+    first = np.argmax(on, 1)[keep]
+    last = _COARSE - 1 - np.argmax(on[:, ::-1], 1)[keep]
+    a0, a1 = a[np.maximum(first - 1, 0)], a[np.minimum(last + 1, _COARSE - 1)]
+    s = seg[keep]
+    d = s[:, 2:4] - s[:, 0:2]
+    return np.concatenate([s[:, 0:2] + a0[:, None] * d, s[:, 0:2] + a1[:, None] * d], 1), flag[keep]
+
+
 def view_lines(seg: np.ndarray, f: Frame, width: int, height: int, c: ColourCalibration, o: Orthophoto,
                raster: Rasterizer, p: LineConfig, ortho: OrthoConfig) -> tuple[np.ndarray, np.ndarray]:
     """Boolean (vertical, horizontal) line maps on ``o``'s grid from one view's segments ``seg`` (N, 4+ px
@@ -115,12 +139,15 @@ def view_lines(seg: np.ndarray, f: Frame, width: int, height: int, c: ColourCali
     keep = np.isfinite(ends).all(1) & (is_v | is_h)
     if not keep.any():
         return vert.astype(bool), horiz.astype(bool)
-    seg, is_v = seg[keep], is_v[keep]
-    # depths of both ends: the sampling is denser where the projection stretches
+    seg, is_v = _within_grid(seg[keep, :4], is_v[keep], f, width, height, c, o)
+    if not len(seg):
+        return vert.astype(bool), horiz.astype(bool)
+    # the pieces' ends on the plane, and their depths: the sampling is denser where the projection stretches
+    ends = segments_on_plane(seg, f, width, height, c, pl.n, pl.u, pl.d)
     xn_ends = normalised_coords(seg[:, [0, 2]], seg[:, [1, 3]], f, width, height, c)
     t_ends = rays_to_plane(xn_ends, f.c2w, pl.n, pl.d)[1]
     ratio = np.nanmax(t_ends, 1) / np.nanmin(t_ends, 1)
-    x, y, idx = _samples(seg, np.hypot(du[keep], dz[keep]), ratio, o.res)
+    x, y, idx = _samples(seg, np.hypot(ends[:, 2] - ends[:, 0], ends[:, 3] - ends[:, 1]), ratio, o.res)
     # the plane is what the view sees at the sample and a margin to either side of the segment
     normal = np.stack([-(seg[:, 3] - seg[:, 1]), seg[:, 2] - seg[:, 0]], 1)
     normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-9)
