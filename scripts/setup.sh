@@ -27,7 +27,7 @@ else
   "$PY" -m pip install -q --disable-pip-version-check -e "$spec"
 fi
 if [[ ",${extras}," == *",test,"* ]] && command -v npm >/dev/null; then
-  # S3-compatible object store for the storage tests (issue 21): s3rver, a Node server keeping objects on disk
+  # S3-compatible object store for the storage tests: s3rver, a Node server keeping objects on disk
   if [ ! -x .tools/s3rver/node_modules/.bin/s3rver ]; then
     echo "[setup] npm install s3rver@3.7.1 into .tools/s3rver ..."
     npm install --silent --no-audit --no-fund --prefix .tools/s3rver s3rver@3.7.1 >/dev/null || echo "[setup] s3rver unavailable: S3 tests will be skipped"

@@ -35,7 +35,7 @@ def configure() -> None:
         os.environ.setdefault(k, v)
     from .storage import configure_result_storage
 
-    configure_result_storage()  # result records beside the shared store (REACT3D_STORE), issue 21
+    configure_result_storage()  # result records beside the shared store (REACT3D_STORE)
 
 
 # --- Which server a command talks to ----------------------------------------------------------------

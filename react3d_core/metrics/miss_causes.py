@@ -1,4 +1,4 @@
-"""Miss-cause breakdown (issue 16): for each GT part that is missed or scored below IoU 0.5, the stage
+"""Miss-cause breakdown: for each GT part that is missed or scored below IoU 0.5, the stage
 where it was lost; for each matched part with a large axis or hinge error, the cause where it can be told.
 
 Why: F1 and OE say *that* parts are lost, not *where*; fixing the pipeline needs the stage. The trace is

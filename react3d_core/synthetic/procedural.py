@@ -171,7 +171,7 @@ def _dresser(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
 
 def _sliding(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun], H: float) -> None:
     """A low sideboard / TV cabinet with a pair of sliding doors (above a drawer row half the time) and a
-    sliding-door wardrobe beside it: sliding doors with GT joints in the front plane (issue 16)."""
+    sliding-door wardrobe beside it: sliding doors with GT joints in the front plane."""
     pal = PALETTES[int(rng.integers(len(PALETTES)))]
     handles = bool(rng.random() < 0.8)
     D, Hs, w = float(rng.uniform(0.4, 0.48)), float(rng.uniform(0.55, 0.8)), float(rng.uniform(1.2, 1.6))
@@ -190,7 +190,7 @@ def _sliding(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
 def _long_kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun],
                   H: float, x_min: float = 0.0) -> None:
     """A full wall of base units (up to 8) with wall cabinets over all of them: two such walls (an L)
-    hold 32-52 openable parts (42 on average over 30 seeds), like the large kitchens of real rooms (issue 16)."""
+    hold 32-52 openable parts (42 on average over 30 seeds), like the large kitchens of real rooms."""
     _kitchen(b, fr, length, rng, runs, H, max_units=8, wall_p=1.0, x_min=x_min)
 
 

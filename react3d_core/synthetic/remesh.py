@@ -2,7 +2,7 @@
 
 A generated scene's own mesh is perfect: every front is a separate slab with a 4 mm gap around it and
 handles are exact boxes. Real scan meshes are not, and perception tuned on perfect meshes fails on
-them (issue 15). So the written mesh can be re-made the way real scans are:
+them. So the written mesh can be re-made the way real scans are:
 
 - ``tsdf``: the scene's own noisy depth frames (256x192, after :func:`.render.sensor_depth`, as
   uint16 mm like ``depth.bin``) and colour frames (the written RGB, area-resized to the depth size)

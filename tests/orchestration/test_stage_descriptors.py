@@ -1,4 +1,4 @@
-"""Stage descriptors are the one place a stage's dependencies are declared (issue #17): cache keys,
+"""Stage descriptors are the one place a stage's dependencies are declared: cache keys,
 the sections a task sees and the manifest's versions all follow from them."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Real scan acceptance (issue 15): 7-Scenes RedKitchen, scored against hand-drawn front boxes.
+"""Real scan acceptance: 7-Scenes RedKitchen, scored against hand-drawn front boxes.
 
 The scan lives outside the repository (../shared/data/redkitchen, non-commercial licence, never copied in);
 the tests skip when it is absent. ``tests/data/redkitchen_fronts.json`` holds 2D boxes of the 9 clearly

@@ -1,4 +1,4 @@
-"""Issue 20 item 7: the content store is verified, not trusted. A flipped byte in a stored object or a
+"""The content store is verified, not trusted. A flipped byte in a stored object or a
 stored export folder is caught (one warning line), quarantined and recomputed; the corrupt copy never
 reaches a user's output; temporaries of killed runs are swept."""
 

@@ -1,4 +1,4 @@
-"""Issue 20, item 8: a failure prints one line first (what, which file, what to do), rc 2 for bad input,
+"""A failure prints one line first (what, which file, what to do), rc 2 for bad input,
 details in a log file; options and config are validated before any stage runs."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 20, item 1: ``--out`` never deletes what react3d did not create (the CLI in this process for
+"""``--out`` never deletes what react3d did not create (the CLI in this process for
 the refusals, which happen before anything starts; a real CLI process for the allowed replacement)."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Issue 20 item 6: an API key never travels in an endpoint URL (it would be stored in scene.json and in
+"""An API key never travels in an endpoint URL (it would be stored in scene.json and in
 Prefect's flow-run parameters); keys come from the environment or a Prefect Secret block."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Item 4 of issue 20: a forged Prefect result record in the shared storage must never run code.
+"""A forged Prefect result record in the shared storage must never run code.
 
 Prefect 3 decodes a record with the serializer the record itself names. These tests forge records the
 way an attacker with write access to ``$PREFECT_HOME/storage`` would (``serializer: pickle``, JSON with

@@ -1,4 +1,4 @@
-"""Issue 20, item 3: bad sensor data is an error naming the file (rc 2), never a silently wrong scene
+"""Bad sensor data is an error naming the file (rc 2), never a silently wrong scene
 (the scan is checked before anything starts: the CLI runs in this process)."""
 
 from __future__ import annotations
