@@ -150,8 +150,9 @@ def _face_samples(mesh: TriMesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndar
 def _boxes_and_coverage(layout: SynthLayout, face_pid: np.ndarray, parts: list[GTPart], scan: TriMesh | None,
                         seen: np.ndarray, glass: np.ndarray) -> dict[int, tuple[OBB, float]]:
     """Per movable GT part: its true box (its faces and its children's in the generated mesh) and the
-    share of its observed opaque surface (faces any frame saw, glass left out) that lies within the
-    transfer radius of the scan mesh (``scan`` None: the written mesh is the generated one, share 1)."""
+    share of its observed opaque surface (faces any frame saw, glass left out; all its opaque faces if
+    no frame saw it) that lies within the transfer radius of the scan mesh (``scan`` None: the written
+    mesh is the generated one, share 1)."""
     mesh = layout.mesh
     out: dict[int, tuple[OBB, float]] = {}
     dist = Rasterizer(scan) if scan is not None and scan.n_faces else None
@@ -162,9 +163,8 @@ def _boxes_and_coverage(layout: SynthLayout, face_pid: np.ndarray, parts: list[G
         own = np.isin(face_pid, [p.part_id] + kids)
         box = part_box(mesh.vertices[np.unique(mesh.faces[own].ravel())])
         obs = np.flatnonzero(own & seen & ~glass)
-        if not len(obs):
-            out[p.part_id] = (box, 0.0)
-            continue
+        if not len(obs):  # no frame saw it: its whole opaque surface
+            obs = np.flatnonzero(own & ~glass)
         pts, w = _face_samples(mesh, obs)
         if scan is None:
             cov = 1.0
