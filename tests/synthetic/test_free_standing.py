@@ -250,3 +250,32 @@ def test_dark_dropout_drops_dark_surfaces_only() -> None:
     assert n_dark > 2000 and n_light > 2000
     assert drop_dark / n_dark > 0.9
     assert drop_light / n_light < 0.02
+
+
+def test_synth_cli_new_kinds_and_dropout(tmp_path: Path) -> None:
+    from flows.cli import main
+
+    assert main(["synth", "--seed", "2", "--kind", "appliances", "--depth-dropout", "dark", "--frames", "1",
+                 "--out", str(tmp_path / "s")]) == 0
+    meta = json.loads((tmp_path / "s" / "synth_meta.json").read_text())
+    assert meta["kind"] == "appliances" and meta["depth_dropout"] == "dark" and meta["pieces"]
+    with pytest.raises(SystemExit):
+        main(["synth", "--out", str(tmp_path / "t"), "--depth-dropout", "bright"])
+
+
+@pytest.mark.slow
+def test_dark_fronts_keep_little_tsdf_surface(synthetic_scene) -> None:  # noqa: ANN001
+    """A dark-kind tuning room as the sets make it (60 frames, TSDF of the dropped depth): most dark
+    fronts keep at most 30 % of their surface, light ones most of theirs; every front stays in the GT."""
+    root = synthetic_scene(seed=340, n_frames=60, kind="dark", mesh="tsdf", depth_dropout="dark", misregister=(2, 1))
+    layout = build_room(340, "dark")
+    albedo = linear_albedo(layout.face_colors)
+    meta = json.loads((root / "synth_meta.json").read_text())
+    by_label = {p.label: p for p in layout.parts}
+    dark, light = [], []
+    for r in meta["parts"]:
+        a = float(np.median(albedo[layout.face_keys == layout.key_ids[by_label[r["label"]].key]]))
+        (dark if a < 0.05 else light if a > 0.2 else []).append(r["scan_coverage"])
+    assert len(dark) >= 10 and np.quantile(dark, 0.75) <= 0.3
+    assert not light or np.median(light) >= 0.8
+    assert len(read_articulate3d(root / "articulate3d").movable) == len(layout.parts)
