@@ -13,6 +13,7 @@ import multiprocessing as mp
 import os
 import resource
 import shutil
+import tempfile
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, nullcontext
@@ -57,16 +58,17 @@ def _peak_rss_mb() -> float:
 
 
 @contextmanager
-def cold_cache(root: str | Path) -> Iterator[Path]:
-    """Run inside an empty object store and Prefect result storage under ``root`` (deleted afterwards).
+def cold_cache(parent: str | Path) -> Iterator[Path]:
+    """Run inside an empty object store and Prefect result storage made fresh under ``parent``.
 
     Content keys make a second run of the same scene a cache hit: timings of a benchmark that follows a
-    check run would otherwise be those of a re-run.
+    check run would otherwise be those of a re-run. The folder is a new one this run made (a unique
+    name), so removing it afterwards can never remove anything else that lives under ``parent``.
     """
     from prefect.settings import PREFECT_LOCAL_STORAGE_PATH, temporary_settings
 
-    root = Path(root)
-    shutil.rmtree(root, ignore_errors=True)
+    Path(parent).mkdir(parents=True, exist_ok=True)
+    root = Path(tempfile.mkdtemp(prefix=".cold-cache-", dir=parent))
     old = os.environ.get("REACT3D_CACHE")
     os.environ["REACT3D_CACHE"] = str(root / "react3d")
     try:
@@ -148,7 +150,7 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
               miss_causes: bool = False) -> dict[str, Any]:
     """Convert and evaluate every entry; failed scenes are reported in ``failed`` and skipped.
 
-    ``cold``: each scene converts with an empty cache (under ``out_dir/cold-cache``, removed after).
+    ``cold``: each scene converts with an empty cache (a fresh ``out_dir/.cold-cache-*``, removed after).
     ``miss_causes``: each scene gets ``miss_causes`` (counts per cause and one row per traced GT part)
     and the result a pooled ``miss_causes`` (every cause key present; docs/evaluation.md)."""
     from react3d_core.config.metrics import EvaluationConfig
@@ -163,7 +165,7 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
         try:
             if "source" not in e and not Path(e["scene_dir"]).is_dir():
                 raise InputError(e["scene_dir"], "scene folder not found")
-            r = run_isolated(run_one, e, str(res_dir), config, str(out_dir / "cold-cache") if cold else None, miss_causes)
+            r = run_isolated(run_one, e, str(res_dir), config, str(out_dir) if cold else None, miss_causes)
             pred = InteractiveScene.load(r["manifest"])
             gt_dir = _gt_dir(Path(e["scene_dir"]))
             if gt_dir is None:
