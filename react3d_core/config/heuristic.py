@@ -134,7 +134,7 @@ class ImageConfig(StageConfig):
     enabled: bool = Field(True, description="Also find fronts in the colour frames (real scans have no seams in the mesh).")
     texture_factor: float = Field(3.0, ge=0, description="Handle/seam thresholds rise to this many times the plane's median response (textured planes).")
     face_depth: tuple[float, float] = Field((-0.02, 0.07), description="Faces this far behind/in front of the plane are taken into a front (m).")
-    coverage_close: float = Field(0.02, ge=0, description="The plane's coverage (its faces' centroids on the orthophoto grid) is closed over this (m).")
+    coverage_close: float = Field(0.02, ge=0, description="The plane's coverage (the scan surface lying flat in its slab, on the orthophoto grid) is closed over this (m).")
     outline_fill_px: int = Field(20, ge=0, description="Holes and notches up to this many orthophoto px wide are inside a plane's outline (handle shadows).")
     min_faces: int = Field(4, ge=1, description="An image front holds at least this many mesh faces.")
     mesh_share: float = Field(0.3, ge=0, le=1, description="An image front lying on a mesh front's faces by more than this share of its faces is left to the mesh front (which stands unless it holds two image fronts with handles).")
@@ -165,6 +165,7 @@ class PlanesConfig(StageConfig):
     min_area: float = Field(0.08, ge=0, description="Smallest vertical plane photographed (m^2; at least fronts.min_w x fronts.min_h).")
     cell: float = Field(0.04, gt=0, description="Pieces of one plane farther apart than this are separate planes (m).")
     min_fragment_area: float = Field(0.03, ge=0, description="Fragments of a plane's coverage smaller than this are not part of it (m^2).")
+    slope_win: float = Field(0.012, gt=0, description="A plane's coverage is the scan surface in its slab (offset_tol) tilted by at most angle_tol_deg, the tilt measured on the surface's offsets averaged over this window (m; at least 3 orthophoto px).")
 
 
 class OrthoConfig(StageConfig):

@@ -25,7 +25,7 @@ from .materials import REALISM, PhotoSettings, render_photo, scene_lights
 from .observed import keep_faces, observed_faces
 from .procedural import SynthLayout
 from .remesh import (LASER_DECIMATION, LASER_VOXEL, MESH_KINDS, TRANSFER_RADIUS, TSDF_VOXEL, TsdfFuser, decimate,
-                     laser_depth, transfer_labels, transfer_parts)
+                     decimate_to, laser_depth, transfer_labels, transfer_parts)
 from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, sensor_depth
 
 # 2: URDF sources keep only observed surfaces; 3: photo realism (default) and laser / TSDF scan meshes;
@@ -75,11 +75,15 @@ def _ray_norm(K: np.ndarray, width: int, height: int) -> np.ndarray:
 
 
 def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: list[GTPart], face_pid: np.ndarray,
-                 meta: list[dict]) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
-    """The fused scan mesh, the GT moved onto it, the meta rows of the parts kept and mesh statistics."""
+                 meta: list[dict], keep: float = 1.0) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
+    """The fused scan mesh (quadric-decimated to ``keep`` of its faces), the GT moved onto it, the meta
+    rows of the parts kept and mesh statistics."""
     new = fuser.mesh()
     if kind == "laser":
         new = decimate(new, LASER_DECIMATION)
+    fused_faces = new.n_faces
+    if keep < 1:
+        new = decimate_to(new, keep)
     tr = transfer_labels(layout.mesh, face_pid, new)
     if kind == "laser":  # a laser scan is coloured from registered photos: the clean colour at the surface
         new = TriMesh(new.vertices, new.faces, tr.colors)
@@ -94,7 +98,7 @@ def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: lis
                      "handle": r["handle_part_id"] in n_faces,
                      "parent_part_id": r["parent_part_id"] if r["parent_part_id"] in n_faces else None})
     stats = {"kind": kind, "voxel": LASER_VOXEL if kind == "laser" else TSDF_VOXEL,
-             "decimation": LASER_DECIMATION if kind == "laser" else 0.0,
+             "decimation": LASER_DECIMATION if kind == "laser" else 0.0, "kept_share": keep, "fused_faces": fused_faces,
              "clean_faces": layout.mesh.n_faces, "clean_vertices": layout.mesh.n_vertices,
              "transfer_radius": TRANSFER_RADIUS, "labelled_vertices": float((tr.vertex_label >= 0).mean()),
              "median_distance_to_clean": float(np.median(tr.distance)) if len(tr.distance) else None,
@@ -104,11 +108,13 @@ def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: lis
 
 def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, seed: int, source: str,
                     scene_id: str | None = None, room_depths: list[float] | None = None, mesh: str = "clean",
-                    realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0)) -> Path:
+                    realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0), decimate: float = 1.0) -> Path:
     """Render ``n_frames`` views of ``layout`` and write the scene folder; returns ``out_dir``.
 
     ``mesh``: the written scan mesh, ``clean`` (the generated geometry), ``laser`` or ``tsdf`` (re-made
-    like a real scan, GT transferred; see :mod:`.remesh`). ``realism``: ``photo`` (materials, lights,
+    like a real scan, GT transferred; see :mod:`.remesh`); ``decimate``: share of that laser / TSDF
+    mesh's faces kept by quadric decimation before the GT is transferred (1: as made; a user's exported
+    scan is often decimated). ``realism``: ``photo`` (materials, lights,
     exposure, blur; :mod:`.materials`) or ``plain`` (flat shading, the generator-version-2 images).
     ``misregister``: colour shifted by (dx, dy) RGB pixels against depth and poses (photo only).
     """
@@ -119,6 +125,10 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
         raise ValueError(f"unknown mesh {mesh!r}; choose from {', '.join(MESH_KINDS)}")
     if realism not in REALISM:
         raise ValueError(f"unknown realism {realism!r}; choose from {', '.join(REALISM)}")
+    if not 0 < decimate <= 1:
+        raise ValueError(f"decimate is the share of faces kept, in (0, 1]; got {decimate}")
+    if decimate < 1 and mesh == "clean":
+        raise ValueError("decimate needs mesh='laser' or 'tsdf' (the clean mesh's ground truth is its own faces)")
     misregister = (float(misregister[0]), float(misregister[1]))
     if realism == "plain" and misregister != (0.0, 0.0):
         raise ValueError("misregister needs realism='photo'")
@@ -166,7 +176,7 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
             pose_json[fid] = {"intrinsic": K.tolist(), "aligned_pose": c2w.tolist(), "timestamp": round(i / 10.0, 3)}
         scan, mesh_stats = layout.mesh, {"kind": "clean"}
         if fuser is not None:
-            scan, gt_parts, meta, mesh_stats = _remeshed_gt(layout, fuser, mesh, gt_parts, face_pid, meta)
+            scan, gt_parts, meta, mesh_stats = _remeshed_gt(layout, fuser, mesh, gt_parts, face_pid, meta, decimate)
         save_mesh(tmp / "scans" / "mesh_aligned_0.05.ply", scan)
         write_depth_bin(tmp / "iphone" / "depth.bin", depths, "per_frame")
         write_json(tmp / "iphone" / "pose_intrinsic_imu.json", pose_json)

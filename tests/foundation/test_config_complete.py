@@ -310,6 +310,7 @@ DEFAULTS = {
     "perception.heuristic.planes.min_area": 0.08,
     "perception.heuristic.planes.cell": 0.04,
     "perception.heuristic.planes.min_fragment_area": 0.03,
+    "perception.heuristic.planes.slope_win": 0.012,
     "perception.heuristic.ortho.resolution": 0.004,
     "perception.heuristic.ortho.max_side_px": 1200,
     "perception.heuristic.ortho.max_views": 30,

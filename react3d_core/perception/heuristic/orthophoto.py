@@ -59,6 +59,12 @@ class Orthophoto:
         return (self.u0 + (np.asarray(cols, float) + 0.5) * self.res,
                 self.v_top - (np.asarray(rows, float) + 0.5) * self.res)
 
+    def grid_points(self) -> np.ndarray:
+        """World points (H, W, 3) of every pixel centre, on the plane."""
+        h, w = self.n_views.shape
+        cols, rows = np.meshgrid(np.arange(w), np.arange(h))
+        return self.plane.to_world(*self.to_uv(cols, rows))
+
 
 @dataclass
 class _View:
