@@ -173,7 +173,12 @@ class OrthoConfig(StageConfig):
 
     resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
     max_side_px: int = Field(1200, ge=1, description="Orthophotos of very large planes get a coarser grid, at most this many px a side.")
-    max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
+    max_views: int = Field(30, ge=1, description="Views fused per plane at most.")
+    pick_spread: bool = Field(True, description="Views are picked for coverage, sharpness and diversity (pick_*); off: the max_views frames seeing most of the plane most frontally (a dense walk's neighbouring frames, all alike).")
+    pick_samples: int = Field(9, ge=1, description="Views are picked on this many x this many sample points of a plane ...")
+    pick_need: int = Field(8, ge=1, description="... each wanting this many views; a view is worth the sum of its sharpness (cosine to the normal over distance) at the samples that still want views ...")
+    pick_sep: float = Field(0.15, ge=0, description="... and once one is taken, views whose camera is within this (m) ...")
+    pick_sep_deg: float = Field(10.0, ge=0, description="... and whose optical axis is within this (deg) of it are passed over (a dense walk's next frames add nothing new).")
     min_cos: float = Field(0.3, ge=0, le=1, description="Views more grazing than this cos to the plane are not used.")
     render_scale: float = Field(0.5, gt=0, le=1, description="Face-id buffer size relative to the colour image.")
     erode_px: int = Field(3, ge=0, description="Depth-buffer pixels kept this far from depth jumps (occluder outlines).")

@@ -14,7 +14,7 @@ Two casts per pixel, both towards the plane (along -n):
   plane, where handles in the mesh stand out.
 
 Where the plane is: the plane cast's hits whose surface is not tilted by more than the plane's angle
-tolerance, the tilt measured on the hit offsets averaged over a small window (the surface's own slope, not
+tolerance, the tilt that of a plane fitted to the hit offsets over a small window (the surface's own slope, not
 its faces' normals: a 1 cm TSDF surface's face normals scatter by tens of degrees, decimated they do not).
 """
 
@@ -27,7 +27,8 @@ import numpy as np
 
 from ...raster import Rasterizer
 
-_MIN_WIN_PX = 3  # the slope window spans at least this many pixels (a central difference needs neighbours)
+_MIN_WIN_PX = 3  # the slope window spans at least this many pixels (a fitted slope needs neighbours)
+_MIN_DET = 1e-3  # px^4: a window whose pixels lie on one line fixes no slope across it
 
 
 @dataclass
@@ -56,17 +57,28 @@ def cast_surface(points: np.ndarray, n: np.ndarray, raster: Rasterizer, tol: flo
 
 
 def flat_surface(offset: np.ndarray, res: float, win: float, max_tilt_deg: float) -> np.ndarray:
-    """Pixels with a surface (finite ``offset``) whose tilt against the plane, from the gradient of the
-    offsets averaged over ``win`` metres (NaN-aware box mean), is at most ``max_tilt_deg``."""
+    """Pixels with a surface (finite ``offset``) whose tilt against the plane is at most ``max_tilt_deg``:
+    the slope of the plane fitted (least squares) to the offsets within a ``win``-metre window, from the
+    window's own pixels only, so it is not flattened at the grid's border or beside holes. Pixels whose
+    window holds no two directions (a lone pixel, a one-pixel line) have no slope and are not flat."""
     seen = np.isfinite(offset)
     if not seen.any():
         return seen
     k = max(_MIN_WIN_PX, int(round(win / res)))
-    w = seen.astype(np.float32)
-    s = cv2.boxFilter(np.where(seen, offset, 0.0).astype(np.float32), -1, (k, k), normalize=False,
-                      borderType=cv2.BORDER_CONSTANT)
-    c = cv2.boxFilter(w, -1, (k, k), normalize=False, borderType=cv2.BORDER_CONSTANT)
-    mean = np.where(c > 0, s / np.maximum(c, 1e-9), np.nan)
-    gy, gx = np.gradient(mean, res)
-    with np.errstate(invalid="ignore"):
-        return seen & (np.hypot(gx, gy) <= np.tan(np.radians(max_tilt_deg)))
+    h, w = offset.shape
+    y, x = np.mgrid[0:h, 0:w].astype(np.float64)
+    o = np.where(seen, offset, 0.0).astype(np.float64) / res  # offsets in px: the slope comes out unitless
+    wt = seen.astype(np.float64)
+
+    def box(a: np.ndarray) -> np.ndarray:
+        return cv2.boxFilter(a, cv2.CV_64F, (k, k), normalize=False, borderType=cv2.BORDER_CONSTANT)
+
+    n = np.maximum(box(wt), 1.0)
+    sx, sy, so = box(wt * x), box(wt * y), box(wt * o)
+    cxx, cyy, cxy = box(wt * x * x) - sx * sx / n, box(wt * y * y) - sy * sy / n, box(wt * x * y) - sx * sy / n
+    cxo, cyo = box(wt * x * o) - sx * so / n, box(wt * y * o) - sy * so / n
+    det = cxx * cyy - cxy * cxy
+    ok = det > _MIN_DET
+    d = np.where(ok, det, 1.0)
+    gx, gy = (cyy * cxo - cxy * cyo) / d, (cxx * cyo - cxy * cxo) / d
+    return seen & ok & (np.hypot(gx, gy) <= np.tan(np.radians(max_tilt_deg)))
