@@ -1,4 +1,4 @@
-"""Where the models backend's perception stage spends its time on a GPU (issue 19): profiler tables and variants.
+"""Where the models backend's perception stage spends its time on a GPU: profiler tables and variants.
 
     python3 benchmarks/profile_models_stage.py --out DIR            # GPU: real architectures, random weights
     python3 benchmarks/profile_models_stage.py --tiny --frames 8 --out DIR   # CPU smoke run

@@ -48,7 +48,7 @@ class Progress:
     The artifact is updated when a stage completes and otherwise at most every ``min_interval_s``: each
     update is an API request, and one per part and frame batch cost a cached conversion 1.3 s."""
 
-    STAGES = ("perception", "segmentation", "articulation", "assembly", "export", "report")
+    STAGES = ("perception", "segmentation", "articulation", "assembly", "export", "physics", "report")
 
     def __init__(self, hook: Callable[[str, int, int], None] | None, min_interval_s: float = 2.0,
                  clock: Callable[[], float] = time.monotonic) -> None:

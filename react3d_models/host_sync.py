@@ -1,4 +1,4 @@
-"""Keeping the host from waiting on the GPU: what the H100 profile of the perception stage showed (issue 19).
+"""Keeping the host from waiting on the GPU: what the H100 profile of the perception stage showed.
 
 With one worker, 32 frames at 1920x1440 took 5.4 s, the GPU busy about a third of it. The host waited:
   * SAM's ViT-H encoder rebuilds its decomposed relative-position tables in every attention layer on every

@@ -15,7 +15,7 @@ from typing import Any
 
 from react3d_core.pipeline import key_material
 
-KEY_VERSION = "2"  # 2: keys derived from the stage descriptors (issue #17)
+KEY_VERSION = "2"  # 2: keys derived from the stage descriptors
 
 
 def canonical(x: Any) -> Any:

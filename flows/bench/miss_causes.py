@@ -1,4 +1,4 @@
-"""Miss-cause breakdown of a converted scene (issue 16): re-run the stages in this process with the
+"""Miss-cause breakdown of a converted scene: re-run the stages in this process with the
 segmentation traced, then attribute every missed / mis-jointed GT part (react3d_core.metrics.miss_causes).
 
 Why a re-run: the flow's cached stage outputs keep the candidates and articulated parts but not the

@@ -26,6 +26,7 @@ from .heuristic import FrontRulesConfig, HeuristicConfig
 from .metrics import EvaluationConfig
 from .models import ModelsConfig
 from .perception import OracleNoiseConfig, PerceptionConfig
+from .physics import PhysicsConfig
 from .scene_io import FrameSelectionConfig
 
 
@@ -43,6 +44,7 @@ class PipelineConfig(StageConfig):
     dedup: DedupConfig = Field(default_factory=DedupConfig, description="Duplicate part removal.")
     assembly: AssemblyConfig = Field(default_factory=AssemblyConfig, description="Carving the background.")
     export: ExportConfig = Field(default_factory=ExportConfig, description="What the exporters write.")
+    physics: PhysicsConfig = Field(default_factory=PhysicsConfig, description="The physics check run after the export.")
     evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig, description="Evaluation protocol thresholds.")
 
     def with_overrides(self, overrides: dict) -> "PipelineConfig":
@@ -100,6 +102,7 @@ __all__ = [
     "ModelsConfig",
     "OracleNoiseConfig",
     "PerceptionConfig",
+    "PhysicsConfig",
     "PipelineConfig",
     "StageConfig",
     "TopKConfig",

@@ -244,6 +244,25 @@ class SeamConfig(StageConfig):
     between_span: float = Field(0.2, ge=0, le=1, description="... else the line with most seam evidence, when it covers more than this share; else the middle.")
 
 
+class LineConfig(StageConfig):
+    """Seams supported by straight line segments that a learned detector (M-LSD) finds in the colour frames,
+    opt-in (perception/heuristic/line_evidence.py; the detector runs in react3d_models/line_segments.py).
+    Visibility along a segment is judged like the orthophotos' (``ortho.render_scale``, ``ortho.erode_px``,
+    ``ortho.edge_jump``, ``ortho.depth_tol``, ``ortho.depth_tol_rel``)."""
+
+    enabled: bool = Field(False, description="Run the line-segment detector on a few views of each plane and let seams that its segments support in several views cut cells (needs the ai-edge-litert package and the M-LSD weights; docs/perception.md).")
+    weights: str | None = Field(None, description="Path to the M-LSD tflite file (M-LSD_512_tiny_fp16.tflite or M-LSD_512_large_fp16.tflite from github.com/navervision/mlsd, tflite_models/); null: the environment variable REACT3D_MLSD_WEIGHTS.")
+    threads: int = Field(2, ge=1, description="CPU threads of the detector.")
+    min_score: float = Field(0.1, ge=0, le=1, description="Segment centres scoring below this are dropped (the detector's own threshold).")
+    min_length_px: float = Field(40.0, ge=0, description="Segments shorter than this (px of the detector's 512 px input) are dropped.")
+    max_frames: int = Field(24, ge=1, description="At most this many frames per scene go through the detector (its cost is per frame) ...")
+    views_per_plane: int = Field(6, ge=1, description="... each plane read in at most this many of them: those seeing most of it, spread apart (parallax moves what is not on the plane).")
+    max_angle_deg: float = Field(4.0, ge=0, le=45, description="A segment on the plane within this of vertical (of horizontal) is vertical (horizontal) line evidence (deg).")
+    tol: float = Field(0.015, ge=0, description="Segments of different views this close across (m) support the same line (pose and colour calibration errors move a line by a few cm between views).")
+    min_views: int = Field(2, ge=1, description="A grid pixel is on a learned line when segments of at least this many views pass through it.")
+    span: float = Field(0.6, ge=0, le=1, description="A learned line cuts a cell that dark lines and colour steps do not when it covers this share of the cell's length (and half of that in each of seams.span_chunks pieces).")
+
+
 class HandleConfig(StageConfig):
     """Handles in the orthophotos and in the mesh (perception/heuristic/front_cells.py, image_fronts.py)."""
 
@@ -399,6 +418,7 @@ class HeuristicConfig(StageConfig):
     calibration: CalibrationConfig = Field(default_factory=CalibrationConfig, description="Image path: colour self-calibration.")
     registration: RegistrationConfig = Field(default_factory=RegistrationConfig, description="Image path: per-view colour registration (opt-in).")
     seams: SeamConfig = Field(default_factory=SeamConfig, description="Image path: seams between fronts.")
+    lines: LineConfig = Field(default_factory=LineConfig, description="Image path: seams supported by learned line segments (opt-in).")
     handles: HandleConfig = Field(default_factory=HandleConfig, description="Image path: handles.")
     cells: CellConfig = Field(default_factory=CellConfig, description="Image path: cells and which become fronts.")
     clutter: ClutterConfig = Field(default_factory=ClutterConfig, description="Image path: cluttered cells are no fronts.")

@@ -16,7 +16,8 @@ from .scene_metrics import SceneMetrics, to_json_dict
 def write_parts_parquet(path: str | Path, scenes: list[SceneMetrics]) -> Path:
     """One row per (scene, tau, GT part)."""
     rows = [r for s in scenes for r in s.parts]
-    cols = ["scene", "tau", "gt_part", "gt_type", "diag", "matched", "pred", "iou", "pred_type", "type_ok", "oe", "md", "mo", "mod"]
+    cols = ["scene", "tau", "gt_part", "gt_type", "diag", "matched", "pred", "iou", "pred_type", "type_ok", "oe", "md", "mo", "mod",
+            "scored_by"]
     table = pa.table({c: [r[c] for r in rows] for c in cols}) if rows else pa.table({c: pa.array([], pa.null()) for c in cols})
     with atomic_path(path) as tmp:
         pq.write_table(table, tmp)

@@ -71,6 +71,43 @@ def _timings_table(timings: dict[str, float]) -> str:
     return f"<h2>Timings (s)</h2><table><tr><th>stage</th><th>seconds</th></tr>{rows}</table>"
 
 
+def _physics_section(scene: InteractiveScene, root: Path) -> str:
+    """The physics check: a summary line per engine and, from physics_check.json, a row per joint and
+    per failed probe (docs/physics.md)."""
+    summary = scene.physics
+    if not summary:
+        return ""
+    from ..physics import PhysicsCheck
+    from ..physics.table import summary_line, touched_text
+
+    head = f"<h2>Physics check: {'pass' if summary.get('passed') else 'FAIL'}</h2>"
+    if summary.get("error"):
+        return head + f"<p>the check could not run: {html.escape(str(summary['error']))}</p>"
+    try:
+        check = PhysicsCheck.model_validate(json.loads((root / str(summary.get("file", ""))).read_text()))
+    except (OSError, ValueError):
+        lines = "".join(f"<li>{html.escape(k)}: {html.escape(json.dumps(v))}</li>" for k, v in summary.get("engines", {}).items())
+        return head + f"<ul>{lines}</ul>"
+    reach = check.thresholds.get("reach_fraction", 0.9)
+    lines = "".join(f"<li>{html.escape(summary_line(e, reach))}</li>" for e in check.engines)
+    rows = []
+    for e in check.engines:
+        for j in e.joints:
+            verdict = "pass" if j.passed else "FAIL: " + "; ".join(j.causes)
+            rows.append(f"<tr><td>{html.escape(e.engine)}</td><td>{html.escape(j.joint)}</td><td>{html.escape(j.object_id or '–')}</td>"
+                        f"<td>{100 * j.reached:.0f} %</td><td>{100 * j.penetration:.1f} cm</td>"
+                        f"<td>{html.escape(touched_text(j.touched)) or '–'}</td><td>{html.escape(verdict)}</td></tr>")
+    table = ("<table><tr><th>engine</th><th>joint</th><th>object</th><th>reached</th><th>penetration</th><th>touched</th>"
+             f"<th>verdict</th></tr>{''.join(rows)}</table>") if rows else ""
+    failed = [(e.engine, p) for e in check.engines for p in e.probes if not p.passed]
+    probes = ""
+    if failed:
+        prow = "".join(f"<tr><td>{html.escape(eng)}</td><td>{p.kind}</td><td>{html.escape(p.object_id)}</td>"
+                       f"<td>{html.escape(p.cause or '')}</td></tr>" for eng, p in failed)
+        probes = f"<h3>Failed probes</h3><table><tr><th>engine</th><th>probe</th><th>object</th><th>cause</th></tr>{prow}</table>"
+    return head + f"<ul>{lines}</ul>" + table + probes
+
+
 REPORT_CACHE_VERSION = "1"
 """Bump when the thumbnails or the viewer payload change: part of the report cache key."""
 
@@ -159,6 +196,7 @@ def write_report(
 def _write_page(scene: InteractiveScene, root: Path, out_path: str | Path | None, metrics: dict[str, Any] | None,
                 thumbs: dict[str, list[str]], payload: dict[str, Any]) -> Path:
     payload = {**payload, "timings": scene.timings, "versions": scene.versions}  # this run's, never the cached ones
-    body = _parts_table(scene, thumbs) + (_metrics_table(metrics) if metrics else "") + _timings_table(scene.timings)
+    body = (_parts_table(scene, thumbs) + (_metrics_table(metrics) if metrics else "") + _physics_section(scene, root)
+            + _timings_table(scene.timings))
     page = build_viewer_html(payload, f"REACT3D · {scene.scene_id}", body, thumbs)
     return write_text(Path(out_path) if out_path else root / "report.html", page)

@@ -1,4 +1,4 @@
-"""Sliding doors (issue 16): the refinement keeps an in-plane axis when the predictor says 'sliding',
+"""Sliding doors: the refinement keeps an in-plane axis when the predictor says 'sliding',
 assembly gives them a travel along their own width, and the heuristic's two-track rule finds them."""
 
 from __future__ import annotations

@@ -32,7 +32,7 @@ REQUIRED_SECTIONS = [
 HISTORY = re.compile(r"\bversions? \d+\b|previous release|this release|last release|earlier release|\bissues? #?\d+"
                      r"|(?<![\w&/])#\d+\b", re.IGNORECASE)
 # docs/server.md is being rewritten elsewhere; drop it from here once it holds no history either.
-HISTORY_EXEMPT = {"changelog.md", "server.md"}
+HISTORY_EXEMPT = {"changelog.md"}
 
 
 def _sections(text: str) -> dict[str, str]:
@@ -139,3 +139,22 @@ def test_result_files_quoted_in_results_and_docs_exist() -> None:
             names |= {n for n in re.findall(r"`([\w.-]+\.(?:json|txt))`", text)} - NOT_RESULTS
         missing += [f"{path.name}: {n}" for n in sorted(names) if not (RESULTS / n).is_file()]
     assert not missing, "quoted result files that are not in benchmarks/results/:\n" + "\n".join(missing)
+
+
+CODE_DIRS = ("react3d_core", "react3d_models", "tasks", "flows", "benchmarks", "scripts", "tests", "deployments")
+ISSUE_REF = re.compile(r"\bissues? #?\d+|\(#\d+\)", re.IGNORECASE)
+
+
+def test_code_comments_do_not_name_issues() -> None:
+    """Comments and docstrings say why, not which issue: the history is in docs/changelog.md and git."""
+    found = []
+    for d in CODE_DIRS:
+        for path in sorted((REPO / d).rglob("*")):
+            if path.suffix not in {".py", ".sh", ".json", ".toml", ".yml", ".yaml"} or path == Path(__file__):
+                continue
+            if "results" in path.relative_to(REPO).parts[:2]:  # stored benchmark outputs quote their own runs
+                continue
+            for i, line in enumerate(path.read_text(encoding="utf-8", errors="replace").splitlines(), 1):
+                if ISSUE_REF.search(line):
+                    found.append(f"{path.relative_to(REPO)}:{i}: {line.strip()[:100]}")
+    assert not found, "issue numbers in code:\n" + "\n".join(found)

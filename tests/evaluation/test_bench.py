@@ -97,9 +97,10 @@ def _start_prefect_server() -> int:
     return s.server_process.pid
 
 
-def test_isolated_run_leaves_no_prefect_server_behind():
+def test_isolated_run_leaves_no_prefect_server_behind(prefect_home_copy, tmp_path, monkeypatch):
     import psutil
 
+    monkeypatch.setenv("PREFECT_HOME", str(prefect_home_copy(tmp_path / "home")))  # migrated: starts in seconds
     pid = run_isolated(_start_prefect_server)
     alive = psutil.pid_exists(pid) and psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
     if alive:

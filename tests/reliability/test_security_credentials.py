@@ -1,4 +1,4 @@
-"""Issue 20 item 6: an API key never travels in an endpoint URL (it would be stored in scene.json and in
+"""An API key never travels in an endpoint URL (it would be stored in scene.json and in
 Prefect's flow-run parameters); keys come from the environment or a Prefect Secret block."""
 
 from __future__ import annotations
@@ -108,31 +108,29 @@ def test_keys_come_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None
 SECRET_BLOCK = """
 import os, sys
 from prefect.blocks.system import Secret
-from prefect.testing.utilities import prefect_test_harness
 from react3d_models.runtime import api_key
-with prefect_test_harness(server_startup_timeout=300):
-    Secret(value=sys.argv[1]).save("react3d-opdmulti-key")
-    os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "react3d-opdmulti-key"
-    print("KEY", api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK") == sys.argv[1])
-    os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "no-such-block"
-    try:
-        api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK")
-    except Exception as exc:
-        print("MISSING", type(exc).__name__, str(exc))
+Secret(value=sys.argv[1]).save("react3d-opdmulti-key")
+os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "react3d-opdmulti-key"
+print("KEY", api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK") == sys.argv[1])
+os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "no-such-block"
+try:
+    api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK")
+except Exception as exc:
+    print("MISSING", type(exc).__name__, str(exc))
 """
 
 
-def test_keys_come_from_a_prefect_secret_block(tmp_path: Path) -> None:
-    """A real Prefect server (the test harness, in its own process): the key is read from a Secret block."""
+def test_keys_come_from_a_prefect_secret_block(tmp_path: Path, prefect_server) -> None:  # noqa: ANN001
+    """A real Prefect server (the run's, used from another process): the key is read from a Secret block."""
     pytest.importorskip("torch")
     env = {k: v for k, v in os.environ.items() if not k.startswith(("PREFECT_", "REACT3D_"))}
-    env.update(PREFECT_HOME=str(tmp_path / "prefect"), PYTHONPATH=str(ROOT), PREFECT_SERVER_ANALYTICS_ENABLED="false",
-               PREFECT_LOGGING_LEVEL="ERROR", PREFECT_SERVER_LOGGING_LEVEL="CRITICAL")
+    env.update(PREFECT_HOME=str(tmp_path / "prefect"), PREFECT_API_URL=prefect_server.url, PYTHONPATH=str(ROOT),
+               PREFECT_LOGGING_LEVEL="ERROR")
     p = subprocess.Popen([sys.executable, "-c", SECRET_BLOCK, SECRET], env=env, cwd=ROOT, text=True,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     try:
         out, err = p.communicate(timeout=600)
-    finally:  # the harness's server must not outlive the test
+    finally:  # nothing it started outlives the test
         with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(p.pid, signal.SIGKILL)
     assert "KEY True" in out, err[-2000:]

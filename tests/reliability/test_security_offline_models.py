@@ -1,4 +1,4 @@
-"""Issue 20 item 10: ``--perception models`` without weights fails in seconds with one line, instead of
+"""``--perception models`` without weights fails in seconds with one line, instead of
 minutes of hub retries. Nothing is downloaded: the hub endpoint is a loopback socket that never answers
 (what a closed network looks like to an HTTP client), and the Hugging Face cache is an empty folder."""
 

@@ -7,16 +7,18 @@ the segmenter, the point segmenter and the predictor share them.
 
 from __future__ import annotations
 
+import importlib
 import logging
 from collections import OrderedDict
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 import cv2
 import numpy as np
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import HeuristicConfig, LineConfig
 from ...data.frames import Frame, SceneInput
 from ...data.masks import ArticulationPrediction, Mask2D
 from ...data.mesh import TriMesh, load_mesh
+from ...errors import ConfigError
 from ...raster import Rasterizer
 from ...scene_io.images import frame_rgb
 from .facets import planar_facets
@@ -36,13 +38,29 @@ MASK_SCORE = 0.9  # a front's mask in a frame
 POINT_MASK_SCORE = 0.8  # the mask under point prompts (a front, else a facet)
 JOINT_SCORE = 0.7  # a front's joint guess
 _RENDER_CACHE = 16  # frames whose renders are kept: the segmenter, point segmenter and predictor share them
+# the learned line-segment detector (perception.heuristic.lines) loads weights and a tflite runtime, so it
+# lives outside the core: (module, loader taking the LineConfig), imported only when the section is enabled
+LINE_DETECTOR = ("react3d_models.line_segments", "load_line_detector")
+
+
+def load_line_detector(cfg: LineConfig) -> Callable[[np.ndarray], np.ndarray]:
+    """The line-segment detector ``perception.heuristic.lines`` asks for (an RGB image -> segments (N, 4+)),
+    from the weight-backed package; a ConfigError (one line) when it cannot be loaded."""
+    module, attr = LINE_DETECTOR
+    try:
+        loader = getattr(importlib.import_module(module), attr)
+    except ImportError as exc:
+        raise ConfigError(f"perception.heuristic.lines needs the {module} module of this package: {exc}") from None
+    return loader(cfg)
 
 
 class HeuristicModel:
     """Facets, fronts and per-frame renders of one scene. Every threshold comes from ``config``
-    (``perception.heuristic``; defaults when None)."""
+    (``perception.heuristic``; defaults when None). ``line_detector``: the learned line-segment detector
+    to use when ``lines.enabled`` (default: the one the section names, loaded here)."""
 
-    def __init__(self, scene: SceneInput, config: HeuristicConfig | None = None) -> None:
+    def __init__(self, scene: SceneInput, config: HeuristicConfig | None = None,
+                 line_detector: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
         h = config if config is not None else HeuristicConfig()
         rules = h.fronts
         self.config = h
@@ -60,7 +78,10 @@ class HeuristicModel:
             taken = np.zeros(self.mesh.n_faces, bool)
             for fr in self.fronts:
                 taken[fr.faces] = True
-            self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, h, taken, self.fronts)
+            if h.lines.enabled and line_detector is None:
+                line_detector = load_line_detector(h.lines)
+            self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, h, taken, self.fronts,
+                                           line_detector)
             self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
         if h.splashback.enabled:  # fronts flush with the wall right above a worktop are splash-back
             self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, h.splashback)) if not drop]

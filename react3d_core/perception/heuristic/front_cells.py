@@ -59,6 +59,21 @@ class Cell:
     seam_cuts: int = 0  # of those cuts, straight seams along the whole cell (``_dip_cut``)
 
 
+@dataclass
+class LearnedLines:
+    """Seam evidence from learned line segments (line_evidence.py) as the cell split reads it: pixels on
+    vertical and on horizontal lines that several views support, the share of a cell's length such a line
+    must cover (``lines.span``), and the columns (rows) a vertical (horizontal) learned cut may not take:
+    those of handles running along it. A learned seam may cross a bar handle: a handle never straddles a
+    seam, so a "handle" across one is two bars joined over the gap, or a reflection."""
+
+    vert: np.ndarray
+    horiz: np.ndarray
+    span: float
+    blocked_c: np.ndarray
+    blocked_r: np.ndarray
+
+
 def _valleys(g: np.ndarray, axis: int, contrast: float, width_px: int) -> np.ndarray:
     """Pixels darker than both neighbours 1 to ``width_px`` px away along ``axis`` by ``contrast``."""
     out = np.zeros(g.shape, bool)
@@ -193,8 +208,11 @@ def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int) -> tu
     return float(bands[0].sum()) / full, float(bands[1].sum()) / full
 
 
-def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg: HeuristicConfig) -> list[Cell]:
-    """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs."""
+def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg: HeuristicConfig,
+                lines: tuple[np.ndarray, np.ndarray] | None = None) -> list[Cell]:
+    """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs.
+    ``lines``: pixels on vertical and on horizontal lines that learned line segments of several views
+    support (line_evidence.py; ``perception.heuristic.lines``), a seam where the brightness shows none."""
     rows, cols = np.nonzero(coverage)
     if not len(rows):
         return []
@@ -209,12 +227,27 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
         blocked_r[h.box[1]:h.box[3]] = True
     col = np.where((o.n_views > 0)[..., None], o.color, np.nan)  # unseen pixels carry no colour
     g = col.mean(-1)
-    cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, g, col)
+    learned = None
+    if lines is not None:
+        along_c = np.zeros(coverage.shape[1], bool)  # columns of vertical handles, rows of horizontal ones
+        along_r = np.zeros(coverage.shape[0], bool)
+        for h in handles:
+            if h.horizontal:
+                along_r[h.box[1]:h.box[3]] = True
+            else:
+                along_c[h.box[0]:h.box[2]] = True
+        learned = LearnedLines(lines[0], lines[1], cfg.lines.span, along_c, along_r)
+    cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, g, col, learned)
     for c in cells:
         c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
+    held = {id(h) for c in cells for h in c.handles}
+    for h in handles:  # centred on a learned cut through it (the cut line is in no cell): the nearest cell
+        if id(h) not in held and cells:
+            x, y = h.center
+            min(cells, key=lambda c: np.hypot(max(c.c0 - x, 0.0, x - c.c1), max(c.r0 - y, 0.0, y - c.r1))).handles.append(h)
     out: list[Cell] = []
     for c in cells:
-        out += _split_handles(c, vert, horiz, coverage, min_px, g, p)
+        out += _split_handles(c, vert, horiz, coverage, min_px, g, p, learned)
     return out
 
 
@@ -332,13 +365,38 @@ def _outline_cut(cov: np.ndarray, axis: int, min_px: int, blocked: np.ndarray) -
     return cut, float(jump[i])
 
 
+def _line_cut(ev: np.ndarray, cov: np.ndarray, axis: int, min_px: int, span: float, chunks: int,
+              blocked: np.ndarray) -> tuple[int, float]:
+    """Best split line on learned line evidence ``ev`` (index in the cell, share of the cell's covered
+    length it covers), keeping ``min_px`` on each side and off ``blocked`` lines; lines covering less than
+    ``span`` (or half of it in any of ``chunks`` pieces) score 0."""
+    prof = _profile(ev, cov, axis)
+    if len(prof) <= 2 * min_px:
+        return -1, 0.0
+    ok = (prof >= span) & (_profile(ev, cov, axis, chunks) >= 0.5 * span) & ~blocked
+    inner = np.where(ok, prof, 0.0)[min_px:len(prof) - min_px]
+    i = _plateau_middle(inner)
+    return i + min_px, float(inner[i])
+
+
+def _plateau_middle(v: np.ndarray) -> int:
+    """Index of the middle of the run of equal values around ``v``'s first maximum: a line drawn a few px
+    wide (learned segments widened by ``lines.tol``) is cut at its centre, not its edge."""
+    i = int(np.argmax(v))
+    j = i
+    while j + 1 < len(v) and v[j + 1] == v[i]:
+        j += 1
+    return (i + j) // 2
+
+
 def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: SeamConfig, q: CellConfig, min_px: int,
            depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray,
-           col: np.ndarray) -> list[Cell]:
-    """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at the most
-    prominent seam by valley counts. Inside a cell holding handles, a horizontal cut must leave a handle
-    on both sides (glossy fronts reflect horizontal table and shelf edges at a constant height; a drawer
-    above a door carries its own handle)."""
+           col: np.ndarray, learned: LearnedLines | None = None) -> list[Cell]:
+    """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at a line that
+    ``learned`` line segments support, else at the most prominent seam by valley counts.
+    Inside a cell holding handles, a horizontal cut must leave a handle on both sides (glossy fronts
+    reflect horizontal table and shelf edges at a constant height; a drawer above a door carries its own
+    handle)."""
     if depth >= q.max_split_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
@@ -352,8 +410,8 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
             else:
                 a = Cell(c.c0, c.r0, c.c1, c.r0 + oh, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
                 b = Cell(c.c0, c.r0 + oh + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
-            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col)
-                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col))
+            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned)
+                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned))
     cv_, sc_v = _dip_cut(g[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
     ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
     sc_v = sc_v if sc_v >= p.dip_z else 0.0
@@ -372,6 +430,14 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
         if st_h > sc_h:
             ch_, sc_h, dip_h = sh_, st_h, False
     straight = int(dip_v if sc_v >= sc_h else dip_h) if max(sc_v, sc_h) > 0.0 else 0
+    if max(sc_v, sc_h) == 0.0 and learned is not None:
+        # a straight line that the learned segments of several views agree on (a seam in a glossy or
+        # evenly lit front shows no dark line)
+        cv_, sc_v = _line_cut(learned.vert[sl], cov[sl], 0, min_px, learned.span, p.span_chunks,
+                              learned.blocked_c[c.c0:c.c1])
+        ch_, sc_h = _line_cut(learned.horiz[sl], cov[sl], 1, min_px, learned.span, p.span_chunks,
+                              learned.blocked_r[c.r0:c.r1])
+        straight = int(max(sc_v, sc_h) > 0.0)
     if max(sc_v, sc_h) == 0.0:
         cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])
         ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
@@ -391,16 +457,22 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
     else:
         a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=n, seam_cuts=k)
         b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=n, seam_cuts=k)
-    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col)
-            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col))
+    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned)
+            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned))
 
 
-def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: SeamConfig) -> int:
-    """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the strongest straight
-    seam (``_dip_scores`` >= ``between_z`` noise units), else the most seam-like line by valley counts
+def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: SeamConfig,
+             learned: np.ndarray | None = None, span: float = 1.0) -> int:
+    """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the line ``learned`` line
+    evidence covers most, when it covers at least ``span`` of the cell; else the strongest straight seam
+    (``_dip_scores`` >= ``between_z`` noise units), else the most seam-like line by valley counts
     (covering more than ``between_span``), else the middle."""
     if hi - lo < 1:
         return (lo + hi) // 2
+    if learned is not None:
+        prof = _profile(learned, cov, axis)[lo:hi]
+        if prof.max() >= span:
+            return lo + _plateau_middle(prof)
     z = _dip_scores(g, cov, axis, min_px, p)[lo:hi]
     if z.max() >= p.between_z:
         return lo + int(np.argmax(z))
@@ -410,7 +482,7 @@ def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int,
 
 
 def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: np.ndarray,
-                   p: SeamConfig) -> list[Cell]:
+                   p: SeamConfig, learned: LearnedLines | None = None) -> list[Cell]:
     """Split a cell between consecutive handles (side by side: at the best column between them;
     stacked: at the best row), recursively, so every cell ends with at most one handle per row/column."""
     if len(c.handles) < 2:
@@ -428,7 +500,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         if hi - lo < 2:
             lo, hi = int(xs[k]), int(xs[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
-        cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p)
+        cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
+                              None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span)
         a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):
@@ -441,9 +514,11 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         if hi - lo < 2:
             lo, hi = int(ys[k]), int(ys[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
-        cut = c.r0 + _between(g[rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p)
+        cut = c.r0 + _between(g[rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p,
+                              None if learned is None else learned.horiz[rs, cs], 1.0 if learned is None else learned.span)
         a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1):
             return [c]
-    return _split_handles(a, vert, horiz, cov, min_px, g, p) + _split_handles(b, vert, horiz, cov, min_px, g, p)
+    return (_split_handles(a, vert, horiz, cov, min_px, g, p, learned)
+            + _split_handles(b, vert, horiz, cov, min_px, g, p, learned))

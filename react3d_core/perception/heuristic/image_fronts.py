@@ -23,6 +23,7 @@ from ...data.mesh import TriMesh
 from ...raster import Rasterizer
 from .front_cells import Cell, Handle, find_handles, off_background, off_threshold, split_cells
 from .fronts import Front, _joint, _neighbours, doors_in_rows
+from .line_evidence import LineSupport, line_support
 from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
 from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
 from .plane_surface import PlaneSurface, cast_surface, flat_surface
@@ -42,6 +43,7 @@ class ImageFronts:
     orthophotos: list[Orthophoto]
     calibration: ColourCalibration
     registration: dict[int, ColourCalibration] = field(default_factory=dict)  # per-view correction by frame index
+    lines: list[LineSupport] = field(default_factory=list)  # learned line support per plane (empty: not used)
 
 
 def floor_height(mesh: TriMesh, cfg: FloorConfig) -> float | None:
@@ -200,21 +202,26 @@ def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[in
 
 def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, read_rgb: Callable[[Frame], np.ndarray],
                       cfg: HeuristicConfig = HeuristicConfig(), taken_faces: np.ndarray | None = None,
-                      mesh_fronts: Sequence[Front] = ()) -> ImageFronts:
+                      mesh_fronts: Sequence[Front] = (),
+                      detect_lines: Callable[[np.ndarray], np.ndarray] | None = None) -> ImageFronts:
     """Fronts from the colour frames (see module docstring), by the rules of ``cfg``. ``taken_faces``
     (bool per face) are faces of fronts already found on the mesh: cells overlapping them are left to
-    the mesh rules."""
+    the mesh rules. ``detect_lines`` (an RGB image -> its line segments (N, 4+: x0, y0, x1, y1 px)) gives
+    learned seam evidence when ``lines.enabled`` (line_evidence.py)."""
     rules, hc, clut = cfg.fronts, cfg.handles, cfg.clutter
     cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, XYZ))
     planes = vertical_planes(mesh, cams.mean(0), cfg.planes, max_tilt=rules.max_tilt,
                              min_area=max(cfg.planes.min_area, rules.min_w * rules.min_h))
     orthos, calib, per_view = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, cfg.ortho,
                                                 cfg.calibration, cfg.registration)
+    supports: list[LineSupport] = []
+    if cfg.lines.enabled and detect_lines is not None:
+        supports = line_support(orthos, frames, raster, read_rgb, detect_lines, lambda fi: per_view.get(fi, calib), cfg)
     centroids = mesh.face_centroids
     fronts: list[Front] = []
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     diffs = []
-    for o in orthos:
+    for i, o in enumerate(orthos):
         surf = cast_surface(o.grid_points(), o.plane.n, raster, cfg.planes.offset_tol, hc.protrusion_depth[1],
                             cfg.planes.offset_tol)
         cov = coverage_map(o, flat_surface(surf.offset, o.res, cfg.planes.slope_win, cfg.planes.angle_tol_deg),
@@ -240,7 +247,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         p = o.plane
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
-        cells = split_cells(o, cov, handles, cfg)
+        cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None)
         tiled = any(max(c.c1 - c.c0, c.r1 - c.r0) * o.res < cfg.cells.min_tile_side
                     and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cfg.cells.min_seen for c in cells)
         for cell in cells:
@@ -267,7 +274,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, cfg)})
-    return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view)
+    return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
 
 
 def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.ndarray | None:
