@@ -167,12 +167,14 @@ def _seamless_cabinet_scene(scale: float = 1.0, shift_px: tuple[float, float] = 
     return mesh, frames, images
 
 
-@pytest.mark.parametrize("scale, shift", [(1.0, (0.0, 0.0)), (0.92, (6.0, -4.0))])
-def test_seamless_mesh_splits_into_two_doors_from_the_images(scale: float, shift: tuple[float, float]) -> None:
+@pytest.mark.parametrize("scale, shift, opt", [(1.0, (0.0, 0.0), {}), (0.92, (6.0, -4.0), {}),
+                                              (1.0, (0.0, 0.0), {"image": {"surface_rays": True}, "ortho": {"pick_spread": True}})])
+def test_seamless_mesh_splits_into_two_doors_from_the_images(scale: float, shift: tuple[float, float], opt: dict) -> None:
+    """Also with the plane surface from rays and the views picked for spread (both opt-in)."""
     mesh, frames, images = _seamless_cabinet_scene(scale, shift)
     facets = planar_facets(mesh)
     assert facets.n <= 4  # the mesh alone has no seam between the doors
-    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id])
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], HeuristicConfig(**opt))
     fronts = sorted(res.fronts, key=lambda f: f.center[0])
     assert len(fronts) == 2, [(np.round(f.center, 2), f.w, f.h) for f in fronts]
     for f, (u0, u1) in zip(fronts, ((0.0, 0.6), (0.6, 1.2))):
@@ -447,7 +449,7 @@ def test_enclosed_handle_shadows_hand_computed() -> None:
 def test_protrusion_map_grows_the_splat_by_one_pixel() -> None:
     """One outward face 3 cm in front of the plane (4 mm px) marks the 3 x 3 px around its centroid's
     pixel; a face 1 cm in front (under the 1.2 cm minimum) or facing away marks nothing."""
-    from react3d_core.perception.heuristic.image_fronts import protrusion_map
+    from react3d_core.perception.heuristic.image_fronts import protrusion_from_faces, protrusion_map
 
     o = _ortho(np.ones((50, 60, 3), np.float32), res=0.004)        # plane y = 0, facing -y; v_top = 0.2
     cen = np.array([[0.1 + 0.002, -0.03, 0.2 - 0.1 - 0.002],      # pixel (row 25, col 25)
@@ -457,6 +459,8 @@ def test_protrusion_map_grows_the_splat_by_one_pixel() -> None:
     expected = np.zeros((50, 60), bool)
     expected[24:27, 24:27] = True
     assert np.array_equal(m, expected)
+    # the same faces splatted by centroid (image.surface_rays off) mark the same pixels
+    assert np.array_equal(protrusion_from_faces(o, cen, nrm, HandleConfig(), 0.0, PlanesConfig().offset_tol), expected)
 
 
 def test_standing_bar_in_the_mesh_is_a_handle() -> None:

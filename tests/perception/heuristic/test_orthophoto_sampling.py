@@ -94,7 +94,8 @@ def _walk_frames() -> list[Frame]:
 def test_views_are_picked_apart_not_from_one_stretch_of_the_walk() -> None:
     """A 2 m x 1 m wall, three views to fuse. Picked for spread: the nearest walk frame (sharpest: cosine
     over distance), then its neighbours within 15 cm and 10 degrees are passed over and the two side
-    frames follow. Without ``pick_spread`` the three are all walk frames, alike and sharing one occluder."""
+    frames follow. Without ``pick_spread`` (the default) the three are all walk frames, alike and sharing
+    one occluder."""
     from react3d_core.config.heuristic import OrthoConfig
     from react3d_core.perception.heuristic.orthophoto import _pick_views
     from react3d_core.perception.heuristic.planes import Plane
@@ -104,8 +105,8 @@ def test_views_are_picked_apart_not_from_one_stretch_of_the_walk() -> None:
     plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
                   (-1.0, 1.0), (0.0, 1.0), 2.0)
     frames = _walk_frames()
-    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=3)) == [{5, 6, 7}]
-    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=3, pick_spread=False))[0] <= set(range(6))
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=3, pick_spread=True)) == [{5, 6, 7}]
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=3))[0] <= set(range(6))
     # with room for all, every frame the spread passed over stays out; without the cap on neighbours, all
-    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=30)) == [{5, 6, 7}]
-    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=30, pick_sep=0.0)) == [set(range(8))]
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=30, pick_spread=True)) == [{5, 6, 7}]
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=30, pick_spread=True, pick_sep=0.0)) == [set(range(8))]
