@@ -39,9 +39,10 @@ def load_spec(spec: str, out_dir: Path, frames: int | None = None) -> list[dict[
             for e in d["scenes"]:
                 src, seed, kind = e.get("source", "procedural"), int(e["seed"]), e.get("kind")
                 # scan realism (generate_scene's mesh / realism / misregister) is part of the scene's name
-                opts = {k: e[k] for k in ("mesh", "realism", "misregister", "depth_dropout") if k in e}
+                opts = {k: e[k] for k in ("mesh", "realism", "misregister", "depth_dropout", "decimate") if k in e}
                 name = "_".join([f"{src}_{kind or 'any'}_{seed}"] + [str(opts[k]) for k in ("mesh", "realism") if k in opts]
-                                + ([f"dropout-{opts['depth_dropout']}"] if opts.get("depth_dropout", "none") != "none" else []))
+                                + ([f"dropout-{opts['depth_dropout']}"] if opts.get("depth_dropout", "none") != "none" else [])
+                                + ([f"d{float(opts['decimate']):g}"] if "decimate" in opts else []))
                 out.append({"name": name, "source": src, "kind": kind, "seed": seed, "n_frames": int(e.get("n_frames", n)),
                             "scene_dir": str(out_dir / "scenes" / f"{name}_f{int(e.get('n_frames', n))}"), "synth": opts})
             return out
