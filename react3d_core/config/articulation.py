@@ -17,6 +17,10 @@ class ArticulationConfig(StageConfig):
     upright_tolerance: float = Field(0.1, ge=0, description="A vertical front keeps a gravity-aligned box unless the "
                                                             "minimal box is smaller by more than this share of its "
                                                             "volume (0: always the minimal box, as the paper).")
+    sliding_min_height_m: float = Field(0.3, ge=0, description="A 'sliding' prediction is kept only with its axis in the "
+                                                              "front plane and on a front at least this tall (a lower "
+                                                              "vertical front sliding sideways is a drawer front, which "
+                                                              "is pulled out along its normal instead).")
 
 
 class LimitConfig(StageConfig):
