@@ -5,9 +5,10 @@ The axis is signed first so that q > 0 moves the part out of its cavity. Then:
 - revolute: sweep the part's points (its hull vertices, so the free edge, corners and handle tips are
   never missed, plus a sample of the rest) and stop before any point that was free when closed comes
   within ``collision_clearance_m`` of other scene geometry it moves into (a wall, a neighbour's front,
-  the worktop, the floor), capped at ``revolute_max_deg``. Between two samples no point moves more than
-  ``sweep_step_m`` (below twice the blocking distance, so no obstacle is stepped over) nor turns more than
-  ``revolute_step_deg``;
+  the worktop, the floor), capped at ``revolute_max_deg``. Samples advance conservatively (no point can
+  pass its threshold before the next one), at least so far that the fastest point moves ``sweep_step_m``
+  (half the band in which it blocks: it lands in the band, never on or in an obstacle, so nothing thin is
+  stepped over) and at most ``revolute_step_deg``;
 - prismatic: the cavity depth, never more than the furniture's own depth (``body_depth``, the cavity
   stage's d_body) and, where that depth was not measured, never more than ``prismatic_max_m``; less
   ``prismatic_margin_m``; then the same sweep along the axis (a drawer at an inside corner runs into the
