@@ -271,3 +271,30 @@ def test_sweep_points_keep_the_extremes() -> None:
     assert len(pts) == 600
     for corner in ([0.55, -0.04, 0.4], [0.6, 0.0, 0.0], [0.6, 0.0, 0.8]):
         assert np.any(np.all(np.isclose(pts, corner), axis=1)), corner
+
+
+def test_the_sweep_moves_the_handle_but_not_the_floor_at_the_outline() -> None:
+    """A door slab (x in [0, 0.6], z in [0, 0.8], front face y = -0.02) with a bar handle in front of it, standing
+    on a floor: the attached faces hold both the handle and floor triangles just in front of the door's bottom
+    edge; what sweeps with the door is the slab and the handle only."""
+    from react3d_core.articulation.types import ArticulatedPart
+    from react3d_core.assembly.scene import attached_faces, moving_faces
+    from react3d_core.data.parts import OBB
+
+    m = MeshBuilder(edge=0.05)
+    m.add_box([0.0, -0.02, 0.0], [0.6, 0.0, 0.8], (150, 90, 60), key="door")
+    m.add_box([0.5, -0.05, 0.3], [0.52, -0.02, 0.5], GREY, key="handle")
+    m.add_box([-1.0, -1.0, -0.02], [2.0, 1.0, 0.0], GREY, key="floor")
+    mesh, keys, ids = m.build()
+    door, handle, floor = (np.flatnonzero(keys == ids[k]) for k in ("door", "handle", "floor"))
+    pf = PartFrame(center=np.array([0.3, -0.01, 0.4]), u=np.array([0.0, 0.0, 1.0]), v=np.array([1.0, 0.0, 0.0]),
+                   n=np.array([0.0, 1.0, 0.0]), su=0.8, sv=0.6, thickness=0.02)
+    p = ArticulatedPart(candidate_id=0, label="openable", score=1.0, face_ids=door,
+                        vertex_ids=np.unique(mesh.faces[door]), initial=Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(0, 0, 0)),
+                        articulation=Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(0, 0, 0)),
+                        obb=OBB(center=(0.3, -0.01, 0.4), axes=((0, 0, 1.0), (1.0, 0, 0), (0, 1.0, 0)), extents=(0.8, 0.6, 0.02)),
+                        front_normal=pf.n, thickness=0.02, flat=True)
+    own = attached_faces(mesh, p, pf)
+    assert own[handle].all() and own[floor].any()  # floor triangles in front of the bottom edge are attached
+    moving = moving_faces(mesh, own, p, pf)
+    assert moving[door].all() and moving[handle].all() and not moving[floor].any()
