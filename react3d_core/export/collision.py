@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -123,28 +123,21 @@ def _coacd(comp: trimesh.Trimesh, max_pieces: int, min_thickness: float) -> list
     return [convex_piece(np.asarray(v), min_thickness, "coacd") for v, _ in parts]
 
 
-def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[ConvexPiece]:
-    """Static background for engines that convexify every collision mesh (MuJoCo, PyBullet child links).
+def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """One slab box per group of triangles (grid cell of the centroid x dominant normal direction).
 
-    Simplified path: faces are grouped by the grid cell of their centroid and by dominant normal
-    direction (+-x, +-y, +-z); each group becomes the PCA box (slab) of its corner points, at least
-    ``min_thickness`` thick, so floors and walls become slabs and a corner never becomes a solid
-    wedge. All groups are fitted at once (batched covariance / eigh / segment min-max).
-    """
-    v, f = mesh.vertices, mesh.faces
-    if not len(f):
-        return []
-    tri = v[f]
-    n = mesh.face_cross
-    keep = np.linalg.norm(n, axis=1) > 1e-15
-    tri, n = tri[keep], n[keep]
-    if not len(tri):
-        return []
+    Returns per group: corners (G,8,3), axes (G,3,3) (rows: normal, two in-plane axes), the
+    surface's own thickness along the normal (G,), and per triangle its group (T,). The normal
+    points out of the surface (the side its faces face) and the slab lies behind the surface:
+    its outer face is the outermost point of the surface, so a surface's collider never stands
+    in front of it. In-plane extents below ``min_thickness`` are padded symmetrically."""
     axis = np.argmax(np.abs(n), axis=1)
     direction = axis * 2 + (n[np.arange(len(n)), axis] > 0)
     cells = np.floor(tri.mean(1) / cell).astype(np.int64)
-    _, g = np.unique(np.column_stack([cells, direction]), axis=0, return_inverse=True)
-    g = np.repeat(g.ravel(), 3)
+    _, g_tri = np.unique(np.column_stack([cells, direction]), axis=0, return_inverse=True)
+    g_tri = g_tri.ravel()
+    g = np.repeat(g_tri, 3)
     P = tri.reshape(-1, 3)
     G = int(g.max()) + 1
     cnt = np.bincount(g, minlength=G).astype(float)
@@ -156,6 +149,8 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[Con
             cov[:, a, b] = cov[:, b, a] = np.bincount(g, D[:, a] * D[:, b], G) / cnt
     _, E = np.linalg.eigh(cov)
     nrm = E[:, :, 0]  # smallest variance: the patch normal
+    facing = np.stack([np.bincount(g_tri, n[:, k], G) for k in range(3)], 1)  # area-weighted face normals
+    nrm = nrm * np.where(np.sum(nrm * facing, 1) < 0, -1.0, 1.0)[:, None]
     # in-plane axes follow the grid (the world axis most perpendicular to the normal), so square
     # cells give tight boxes; PCA's in-plane axes are arbitrary for a square and overshoot by 41 %
     k = np.argmin(np.abs(nrm), axis=1)
@@ -167,15 +162,72 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[Con
     starts = np.flatnonzero(np.r_[True, np.diff(g[order]) != 0])
     lo = np.minimum.reduceat(local[order], starts, axis=0)
     hi = np.maximum.reduceat(local[order], starts, axis=0)
-    ext = np.maximum(hi - lo, min_thickness)
-    centre = mu + np.einsum("gij,gj->gi", R, (lo + hi) / 2)
-    unit = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
-    corners = centre[:, None, :] + np.einsum("cj,gj,gij->gci", np.asarray(unit.vertices), ext, R)
-    faces = np.asarray(unit.faces)
+    thickness = hi[:, 0] - lo[:, 0]
+    lo[:, 0] = np.minimum(lo[:, 0], hi[:, 0] - min_thickness)  # behind the surface
+    pad = np.maximum(min_thickness - (hi[:, 1:] - lo[:, 1:]), 0) / 2
+    lo[:, 1:] -= pad
+    hi[:, 1:] += pad
+    unit = np.asarray(trimesh.creation.box(extents=(1.0, 1.0, 1.0)).vertices) + 0.5  # corners in [0, 1]^3
+    local_corners = lo[:, None, :] + unit[None] * (hi - lo)[:, None, :]
+    corners = mu[:, None, :] + np.einsum("gcj,gij->gci", local_corners, R)
+    return corners, np.transpose(R, (0, 2, 1)), thickness, g_tri
+
+
+def _slab_pieces(corners: np.ndarray) -> list[ConvexPiece]:
+    faces = np.asarray(trimesh.creation.box(extents=(1.0, 1.0, 1.0)).faces)
     return [ConvexPiece(c, faces, "patch") for c in corners]
 
 
-COLLISION_VERSION = "1"
+def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: float | None = None,
+                   flatness: float | None = None, obstacles: Sequence = (), margin: float = 0.0,
+                   faces: np.ndarray | None = None, extra: np.ndarray | None = None) -> list[ConvexPiece]:
+    """Static background for engines that convexify every collision mesh (MuJoCo, PyBullet child links).
+
+    Faces are grouped by the grid cell of their centroid and by dominant normal direction (+-x, +-y,
+    +-z); each group becomes a slab box behind its surface (at least ``min_thickness`` thick), so
+    floors and walls become slabs and a corner never becomes a solid wedge. All groups are fitted
+    at once (batched covariance / eigh / segment min-max).
+
+    Refinement (``min_cell`` given): a slab thicker than ``flatness`` (several parallel surfaces in
+    one cell: a front and the wall behind it) or within ``margin`` of an obstacle
+    (``clearance.Obstacle``: a part's path, a carcass) is refitted from its faces in cells half as
+    large, down to ``min_cell``; slabs still too close are then cut back (``clearance.keep_clear``).
+    ``faces``: indices of the faces to use (default all); ``extra``: more triangles (k,3,3).
+    """
+    from .clearance import box_conflicts, keep_clear
+
+    f = mesh.faces if faces is None else mesh.faces[np.asarray(faces, np.int64)]
+    tri = mesh.vertices[f]
+    if extra is not None and len(extra):
+        tri = np.concatenate([tri, np.asarray(extra, float)])
+    if not len(tri):
+        return []
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    keep = np.linalg.norm(n, axis=1) > 1e-15
+    tri, n = tri[keep], n[keep]
+    if not len(tri):
+        return []
+    out: list[ConvexPiece] = []
+    close: list[ConvexPiece] = []
+    size = cell
+    while len(tri):
+        corners, axes, thickness, g_tri = _fit_slabs(tri, n, size, min_thickness)
+        last = min_cell is None or size / 2 < min_cell
+        near = box_conflicts(corners, axes, obstacles, margin) if len(obstacles) else np.zeros(len(corners), bool)
+        split = np.zeros(len(corners), bool) if last else near | (thickness > flatness if flatness is not None else False)
+        out += _slab_pieces(corners[~split & ~near])
+        close += _slab_pieces(corners[~split & near])
+        if last or not split.any():
+            break
+        sel = split[g_tri]
+        tri, n = tri[sel], n[sel]
+        size /= 2
+    if close:
+        close, _ = keep_clear(close, obstacles, margin)
+    return out + close
+
+
+COLLISION_VERSION = "2"
 """Bump when convex_pieces / planar_patches change their output: it is part of the cache key."""
 
 

@@ -3,6 +3,13 @@
 MuJoCo convexifies every mesh, so collision pieces are inline convex meshes (one geom each) and the
 static background collides through its planar patches; the textured OBJ visuals (group 1) do not
 collide. Joint frames match the URDF: the part body sits at the articulation origin.
+
+Collision policy, stated in the file: every collision geom has ``contype="1" conaffinity="1"`` (a
+robot with the defaults collides with every part, carcass and the background); a part and its own
+carcass are excluded (``<contact><exclude>``): MuJoCo's parent-child filter does not apply to a
+carcass welded to the world, while PyBullet (parent exclusion) and PhysX (jointed bodies) skip that
+pair, so all engines agree. Static bodies (background, carcasses) never collide with each other in
+MuJoCo. The colliders are separated at export (``clearance``), so nothing starts in contact.
 """
 
 from __future__ import annotations
@@ -75,7 +82,7 @@ def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
         '  <option timestep="0.002" gravity="0 0 -9.81"/>',
         "  <default>",
         '    <default class="visual"><geom contype="0" conaffinity="0" group="1" density="0"/></default>',
-        '    <default class="collision"><geom group="3" rgba="0.5 0.5 0.5 0.3" density="0"/></default>',
+        '    <default class="collision"><geom contype="1" conaffinity="1" group="3" rgba="0.5 0.5 0.5 0.3" density="0"/></default>',
         f'    <joint damping="{_f(config.joint_damping)}"/>',
         "  </default>",
         "  <asset>",
@@ -109,7 +116,13 @@ def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
             out += body(link, np.zeros(3), "    ")
     for c in children.get("background", []):
         out += body(c, np.zeros(3), "    ")
-    out += ["  </worldbody>", "</mujoco>"]
+    out.append("  </worldbody>")
+    excluded = [j for j in model.joints if model.link(j.parent).role == "base"]
+    if excluded:
+        out.append("  <contact>")
+        out += [f'    <exclude name="{j.child}__own_carcass" body1="{j.parent}" body2="{j.child}"/>' for j in excluded]
+        out.append("  </contact>")
+    out.append("</mujoco>")
     return "\n".join(out) + "\n"
 
 

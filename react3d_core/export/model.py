@@ -8,6 +8,7 @@ rotation (URDF/MJCF) or only an axis-aligning rotation (USD).
 
 from __future__ import annotations
 
+import hashlib
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,6 +20,7 @@ from ..data.mesh import TriMesh, load_mesh
 from ..data.parts import Articulation, InteractiveScene
 from ..errors import InputError
 from ..texture import TexturedMesh, bake_texture
+from .clearance import Obstacle, carve_faces, clear_paths, hull_obstacle, keep_clear, separate_at_rest, sweep_obstacles
 from .collision import ConvexPiece, cached_pieces, convex_pieces, planar_patches
 from .inertia import Inertial, inertial_from_pieces
 
@@ -42,6 +44,8 @@ class Link:
     inertial: Inertial | None = None
     object_id: str | None = None
     role: str = "background"  # background, base, part
+    collide_faces: np.ndarray | None = None  # static_mesh faces that collide (the rest lies in a part's path or a carcass)
+    fragments: np.ndarray | None = None  # (k,3,3) colliding pieces of big static faces that were only partly in the way
 
 
 @dataclass
@@ -58,6 +62,7 @@ class SceneModel:
     scene_id: str
     links: list[Link]
     joints: list[Joint]
+    clearance: dict[str, float] = field(default_factory=dict)  # what separating the colliders did (counts, deepest conflict left)
 
     def link(self, name: str) -> Link:
         return next(link for link in self.links if link.name == name)
@@ -70,10 +75,71 @@ def _mesh(root: Path, rel: str | None) -> TriMesh | None:
     return load_mesh(p)
 
 
+@dataclass
+class _Object:
+    """One object while its colliders are being separated."""
+
+    oid: str
+    obj: object
+    part_meshes: list[TriMesh]
+    part: list[ConvexPiece]
+    base_mesh: TriMesh | None
+    base: list[ConvexPiece] | None
+    sweep: list[Obstacle] = field(default_factory=list)
+
+
+def obstacle_digest(obstacles: list[Obstacle]) -> str:
+    """Content hash of obstacles (cache key of the background carved around them)."""
+    h = hashlib.sha256()
+    for ob in obstacles:
+        h.update(np.ascontiguousarray(ob.vertices, np.float64).tobytes())
+        h.update(np.float64(ob.grow).tobytes())
+    return h.hexdigest()[:16]
+
+
+def separate_colliders(objects: list[_Object], config: ExportConfig) -> tuple[list[Obstacle], dict[str, float]]:
+    """Cut part and carcass pieces back so that no pair overlaps at rest and nothing static stands in a
+    part's path (``clearance`` module); returns the obstacles the background must keep clear of.
+
+    Order of precedence: parts over carcasses and background (a part is what a robot handles; the
+    carcass is estimated); of two part pieces overlapping at rest the smaller yields; of two carcasses
+    the earlier object's. Where a part's path meets another part at rest, the cut that removes less
+    volume is made, up to ``part_trim_max_fraction`` of a piece (``clearance.clear_paths``); deeper
+    conflicts are left to the joint limits."""
+    m = config.collider_clearance_m
+    stats = {"parts_cut": 0, "carcass_cut": 0, "pieces_dropped": 0, "part_conflicts_left": 0}
+    parts, st = separate_at_rest([o.part for o in objects], m)
+    stats["parts_cut"] += st.cut
+    stats["pieces_dropped"] += st.dropped
+    for o, pieces in zip(objects, parts):
+        o.part = pieces
+    parts, st = clear_paths([o.part for o in objects], [o.obj.articulation for o in objects], m, config.part_trim_max_fraction)
+    stats["parts_cut"] += st.cut
+    stats["pieces_dropped"] += st.dropped
+    stats["part_conflicts_left"] = st.left
+    for o, pieces in zip(objects, parts):
+        o.part = pieces
+        o.sweep = sweep_obstacles(o.part, o.obj.articulation, o.oid, m)
+    sweeps = [ob for o in objects for ob in o.sweep]
+    carcasses: list[Obstacle] = []
+    for o in objects:  # carcasses: out of every path and of earlier carcasses
+        if o.base is None:
+            continue
+        o.base, st = keep_clear(o.base, sweeps + carcasses, m)
+        stats["carcass_cut"] += st.cut
+        stats["pieces_dropped"] += st.dropped
+        hull = hull_obstacle(np.vstack([p.vertices for p in o.base]), o.oid, "carcass") if o.base else None
+        if hull is not None:
+            carcasses.append(hull)
+    return sweeps + carcasses, stats
+
+
 def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportConfig | None = None,
                       cache_dir: str | Path | None = None) -> SceneModel:
     """Bake textures, decompose collisions and compute inertials for every link of ``scene``.
 
+    Colliders are separated (``separate_colliders``) and the background's patches and triangles
+    carved around every part's path and every carcass (``collider_clearance_m``).
     ``cache_dir``: convex pieces and background patches are read from / written to it, keyed by mesh
     content and settings (``collision.cached_pieces``); None computes them every time."""
     config = config or ExportConfig()
@@ -85,20 +151,7 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
     def pieces_of(mesh: TriMesh, budget: int) -> list[ConvexPiece]:
         return cached_pieces(cache_dir, "convex", mesh, (budget, thick), lambda: convex_pieces(mesh, budget, thick))
 
-    patches = cached_pieces(cache_dir, "patches", bg, (config.background_patch_m, thick),
-                            lambda: planar_patches(bg, config.background_patch_m, thick))
-    links = [
-        Link(
-            "background",
-            np.zeros(3),
-            visuals=[bake_texture(bg, config)],
-            static_mesh=bg,
-            patches=patches,
-            # static: the inertial only keeps importers from guessing (PyBullet warns, MuJoCo guesses density)
-            inertial=Inertial(config.min_mass_kg, bg.vertices.mean(0), np.full(3, 1e-3), np.eye(3)),
-        )
-    ]
-    joints: list[Joint] = []
+    objects: list[_Object] = []
     seen: set[str] = set()
     for obj in scene.objects:
         oid = safe_name(obj.object_id)
@@ -110,27 +163,51 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
             raise InputError(root / "scene.json", f"object {obj.object_id}: joint limits [{art.lower}, {art.upper}] must satisfy lower <= 0 <= upper, lower < upper")
         part = _mesh(root, obj.part_mesh)
         assert part is not None
-        inner = _mesh(root, obj.inner_mesh)
+        moving = [m for m in (part, _mesh(root, obj.inner_mesh)) if m is not None]
+        budget = max(1, config.max_convex_hulls // len(moving))
         base = _mesh(root, obj.base_mesh)
-        if base is not None:
-            pieces = pieces_of(base, config.max_convex_hulls)
+        objects.append(_Object(oid, obj, moving, [p for m in moving for p in pieces_of(m, budget)], base,
+                               pieces_of(base, config.max_convex_hulls) if base is not None else None))
+    obstacles, stats = separate_colliders(objects, config)
+    margin = config.collider_clearance_m
+    keep, fragments = carve_faces(bg.vertices, bg.faces, obstacles, margin, 4 * config.background_patch_min_m)
+    params = (config.background_patch_m, thick, config.background_patch_min_m, config.background_patch_flatness_m, margin,
+              obstacle_digest(obstacles))
+    patches = cached_pieces(cache_dir, "patches", bg, params, lambda: planar_patches(
+        bg, config.background_patch_m, thick, config.background_patch_min_m, config.background_patch_flatness_m, obstacles, margin,
+        faces=np.flatnonzero(keep), extra=fragments))
+    stats["background_faces_carved"] = int((~keep).sum())
+    links = [
+        Link(
+            "background",
+            np.zeros(3),
+            visuals=[bake_texture(bg, config)],
+            static_mesh=bg,
+            patches=patches,
+            # static: the inertial only keeps importers from guessing (PyBullet warns, MuJoCo guesses density)
+            inertial=Inertial(config.min_mass_kg, bg.vertices.mean(0), np.full(3, 1e-3), np.eye(3)),
+            collide_faces=keep,
+            fragments=fragments,
+        )
+    ]
+    joints: list[Joint] = []
+    for o in objects:
+        obj, oid, art = o.obj, o.oid, o.obj.articulation
+        if o.base_mesh is not None:
             links.append(
                 Link(
-                    f"{oid}__base", np.zeros(3), [bake_texture(base, config)], pieces,
-                    inertial=inertial_from_pieces(pieces, config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="base",
+                    f"{oid}__base", np.zeros(3), [bake_texture(o.base_mesh, config)], o.base or [],
+                    inertial=inertial_from_pieces(o.base or [], config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="base",
                 )
             )
             parent = f"{oid}__base"
         else:
             parent = "background"
-        moving = [m for m in (part, inner) if m is not None]
-        budget = max(1, config.max_convex_hulls // len(moving))
-        pieces = [p for m in moving for p in pieces_of(m, budget)]
         links.append(
             Link(
-                f"{oid}__part", np.asarray(art.origin, float), [bake_texture(m, config) for m in moving], pieces,
-                inertial=inertial_from_pieces(pieces, config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="part",
+                f"{oid}__part", np.asarray(art.origin, float), [bake_texture(m, config) for m in o.part_meshes], o.part,
+                inertial=inertial_from_pieces(o.part, config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="part",
             )
         )
         joints.append(Joint(f"{oid}__joint", obj.object_id, parent, f"{oid}__part", art))
-    return SceneModel(safe_name(scene.scene_id), links, joints)
+    return SceneModel(safe_name(scene.scene_id), links, joints, stats)

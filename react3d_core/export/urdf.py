@@ -7,6 +7,13 @@ collides through convex planar patches: PyBullet ignores ``concave="yes"`` on a 
 MuJoCo convexifies every mesh, so one triangle-mesh collider became the room's solid hull (measured:
 a dropped ball was expelled through the floor). The ``<mujoco>`` block keeps
 visuals and the static bodies when MuJoCo imports this URDF.
+
+Collision policy: URDF has no element for it, so it is what the engines do, written into the file
+as a comment. PyBullet collides links of one body only with ``URDF_USE_SELF_COLLISION`` (add
+``URDF_USE_SELF_COLLISION_EXCLUDE_PARENT`` so a part and its carcass do not collide); SAPIEN/PhysX
+collide all links of an articulation except a joint's two; MuJoCo's URDF import collides a part with
+its carcass (add an ``<exclude>`` or use the MJCF). The colliders are separated at export
+(``clearance``), so self-collision on starts without contacts.
 """
 
 from __future__ import annotations
@@ -44,9 +51,16 @@ def _inertial(link: Link) -> list[str]:
     ]
 
 
+POLICY = (
+    "<!-- Collision policy: colliders are separated at rest and around every part's path. Load with self-collision on and "
+    "parent exclusion (PyBullet: URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_EXCLUDE_PARENT; SAPIEN/PhysX do this by "
+    "default) so a part never collides with its own carcass (its parent link) and collides with everything else. -->"
+)
+
+
 def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConfig, prefix: str = "") -> str:
     """The URDF document; mesh paths are ``prefix + relative path`` (``package://pkg/`` for ROS)."""
-    out = ['<?xml version="1.0"?>', f"<robot name={quoteattr(model.scene_id)}>"]
+    out = ['<?xml version="1.0"?>', POLICY, f"<robot name={quoteattr(model.scene_id)}>"]
     out += ["  <mujoco>", '    <compiler strippath="false" discardvisual="false" fusestatic="false" balanceinertia="true"/>', "  </mujoco>"]
     out += ['  <link name="world"/>']
     for link in model.links:
