@@ -120,7 +120,7 @@ def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
     excluded = [j for j in model.joints if model.link(j.parent).role == "base"]
     if excluded:
         out.append("  <contact>")
-        out += [f'    <exclude name="{j.child}__own_carcass" body1="{j.parent}" body2="{j.child}"/>' for j in excluded]
+        out += [f'    <exclude name="{j.child}_own_carcass" body1="{j.parent}" body2="{j.child}"/>' for j in excluded]
         out.append("  </contact>")
     out.append("</mujoco>")
     return "\n".join(out) + "\n"

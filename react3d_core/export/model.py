@@ -31,6 +31,16 @@ def safe_name(text: str) -> str:
     return s if s and not s[0].isdigit() else f"_{s}"
 
 
+RESERVED = ("world", "background", "background_fixed")
+"""Link and joint names every export uses for itself."""
+
+
+def link_names(oid: str) -> dict[str, str]:
+    """Names an object's links and joint get in every format: the part is the object (``drawer_03``),
+    its joint ``drawer_03_joint``, its carcass ``drawer_03_base`` (fixed by ``drawer_03_base_fixed``)."""
+    return {"part": oid, "joint": f"{oid}_joint", "base": f"{oid}_base", "fixed": f"{oid}_base_fixed"}
+
+
 @dataclass
 class Link:
     """One rigid body. ``frame`` is the link origin in world coordinates (rotation is identity)."""
@@ -152,12 +162,13 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
         return cached_pieces(cache_dir, "convex", mesh, (budget, thick), lambda: convex_pieces(mesh, budget, thick))
 
     objects: list[_Object] = []
-    seen: set[str] = set()
+    seen: set[str] = set(RESERVED)
     for obj in scene.objects:
         oid = safe_name(obj.object_id)
-        if oid in seen:
-            raise InputError(root / "scene.json", f"object ids collide after sanitizing: {obj.object_id!r}")
-        seen.add(oid)
+        clash = seen.intersection(link_names(oid).values())
+        if clash:
+            raise InputError(root / "scene.json", f"object {obj.object_id!r}: its link/joint names {sorted(clash)} collide with another object's or a reserved name")
+        seen.update(link_names(oid).values())
         art = obj.articulation
         if not (art.lower <= 0.0 <= art.upper) or art.upper - art.lower <= 0:
             raise InputError(root / "scene.json", f"object {obj.object_id}: joint limits [{art.lower}, {art.upper}] must satisfy lower <= 0 <= upper, lower < upper")
@@ -193,21 +204,22 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
     joints: list[Joint] = []
     for o in objects:
         obj, oid, art = o.obj, o.oid, o.obj.articulation
+        names = link_names(oid)
         if o.base_mesh is not None:
             links.append(
                 Link(
-                    f"{oid}__base", np.zeros(3), [bake_texture(o.base_mesh, config)], o.base or [],
+                    names["base"], np.zeros(3), [bake_texture(o.base_mesh, config)], o.base or [],
                     inertial=inertial_from_pieces(o.base or [], config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="base",
                 )
             )
-            parent = f"{oid}__base"
+            parent = names["base"]
         else:
             parent = "background"
         links.append(
             Link(
-                f"{oid}__part", np.asarray(art.origin, float), [bake_texture(m, config) for m in o.part_meshes], o.part,
+                names["part"], np.asarray(art.origin, float), [bake_texture(m, config) for m in o.part_meshes], o.part,
                 inertial=inertial_from_pieces(o.part, config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="part",
             )
         )
-        joints.append(Joint(f"{oid}__joint", obj.object_id, parent, f"{oid}__part", art))
+        joints.append(Joint(names["joint"], obj.object_id, parent, names["part"], art))
     return SceneModel(safe_name(scene.scene_id), links, joints, stats)

@@ -84,14 +84,14 @@ def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
             ]
         out.append("  </link>")
     out += [
-        '  <joint name="world__background" type="fixed">',
+        '  <joint name="background_fixed" type="fixed">',
         '    <parent link="world"/><child link="background"/><origin xyz="0 0 0" rpy="0 0 0"/>',
         "  </joint>",
     ]
     for link in model.links:
         if link.role == "base":
             out += [
-                f'  <joint name="{link.name}__fixed" type="fixed">',
+                f'  <joint name="{link.name}_fixed" type="fixed">',
                 f'    <parent link="background"/><child link="{link.name}"/><origin xyz="{_v(link.frame)}" rpy="0 0 0"/>',
                 "  </joint>",
             ]

@@ -1,7 +1,8 @@
 """USD writer (usd-core, UsdPhysics): one stage in metres, z up, kilograms.
 
-Per object: an Xform carrying ``ArticulationRootAPI`` (exactly one root per articulation) holding a
-base rigid body fixed to the world, a part rigid body and its revolute/prismatic joint. UsdPhysics
+Per object: an Xform ``/World/<object>`` carrying ``ArticulationRootAPI`` (exactly one root per
+articulation) holding the carcass body ``<object>_base`` fixed to the world, the part body ``<object>``
+and its revolute/prismatic joint ``<object>_joint`` (the URDF's and MJCF's link and joint names). UsdPhysics
 joint axes are only X/Y/Z, so both local joint frames are rotated to map +X onto the articulation
 axis (an axis near -X uses a half turn about Z, where the shortest-arc formula breaks down); body0's
 and body1's frames are the same world frame, so PhysX does not move bodies at load. Moving bodies
@@ -229,7 +230,7 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig, files: 
     background_colliders = _background(stage, bg, files["background"])
 
     for j in model.joints:
-        oid = j.child[: -len("__part")]
+        oid = j.child  # the part link is named after its object
         root = f"/World/{oid}"
         UsdGeom.Xform.Define(stage, root)
         UsdPhysics.ArticulationRootAPI.Apply(stage.GetPrimAtPath(root))
@@ -238,22 +239,22 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig, files: 
         part = model.link(j.child)
         body0: str | None = None
         if parent.role == "base":
-            body0 = f"{root}/base"
+            body0 = f"{root}/{parent.name}"
             _body(stage, body0, parent, files[parent.name])
             # static against static: the carcass never moves, so contacts with the background would only cost
             UsdPhysics.FilteredPairsAPI.Apply(stage.GetPrimAtPath(body0)).CreateFilteredPairsRel().SetTargets(background_colliders)
-            fixed = UsdPhysics.FixedJoint.Define(stage, f"{root}/base_fixed")
+            fixed = UsdPhysics.FixedJoint.Define(stage, f"{root}/{parent.name}_fixed")
             fixed.CreateCollisionEnabledAttr(False)
             fixed.CreateBody1Rel().SetTargets([Sdf.Path(body0)])
             fixed.CreateLocalPos0Attr(_vec3f(parent.frame))
             fixed.CreateLocalRot0Attr(Gf.Quatf(1.0))
             fixed.CreateLocalPos1Attr(Gf.Vec3f(0, 0, 0))
             fixed.CreateLocalRot1Attr(Gf.Quatf(1.0))
-        body1 = f"{root}/part"
+        body1 = f"{root}/{part.name}"
         _body(stage, body1, part, files[part.name])
         a = j.articulation
         revolute = a.joint_type == "revolute"
-        joint = (UsdPhysics.RevoluteJoint if revolute else UsdPhysics.PrismaticJoint).Define(stage, f"{root}/joint")
+        joint = (UsdPhysics.RevoluteJoint if revolute else UsdPhysics.PrismaticJoint).Define(stage, f"{root}/{j.name}")
         joint.CreateAxisAttr(UsdPhysics.Tokens.x)
         joint.CreateCollisionEnabledAttr(False)  # a part and its own carcass never collide (as in URDF engines and the MJCF)
         if body0 is not None:

@@ -28,9 +28,9 @@ def test_manifest_records_exports(exported: dict[str, Path]) -> None:
     urdf_dir = exported["urdf"].parent
     assets = root / "export" / "assets"
     assert (urdf_dir / "display.launch.py").is_file() and (urdf_dir / "display.launch").is_file()
-    assert (assets / "drawer__part" / "visual_0.glb").is_file()
+    assert (assets / "drawer" / "visual_0.glb").is_file()
     # one folder per visual: trimesh's fixed MTL/PNG names never collide
-    for link in ("background", "door__base", "door__part", "drawer__base", "drawer__part"):
+    for link in ("background", "door_base", "door", "drawer_base", "drawer"):
         assert (assets / link / "visual_0" / "material_0.png").is_file()
     # every mesh and texture is written once, in the shared assets: the format folders hold none
     for fmt in ("urdf", "mjcf", "usd"):
@@ -194,7 +194,7 @@ def test_jpeg_textures_load_in_all_simulators(scene_dir: Path, tmp_path: Path) -
     d = tmp_path / "scene"
     shutil.copytree(scene_dir, d)
     out = export_scene(d, config=ExportConfig(texel_per_m=100, texture_format="jpg", write_glb=False))
-    tex = d / "export" / "assets" / "door__part" / "visual_0"
+    tex = d / "export" / "assets" / "door" / "visual_0"
     assert (tex / "material_0.jpg").is_file() and (tex / "material_0.png").is_file()
     assert "map_Kd material_0.jpg" in (tex / "material.mtl").read_text()
     assert mujoco.MjModel.from_xml_path(str(out["mjcf"])).ntex >= 5

@@ -46,7 +46,7 @@ def test_usd_joint_world_axis_and_limits_match_articulation(exported: dict[str, 
     scene = InteractiveScene.load(exported["urdf"].parents[2] / "scene.json")
     stage = Usd.Stage.Open(str(exported["usd"]))
     for obj in scene.objects:
-        prim = stage.GetPrimAtPath(f"/World/{obj.object_id}/joint")
+        prim = stage.GetPrimAtPath(f"/World/{obj.object_id}/{obj.object_id}_joint")
         art = obj.articulation
         origin, axis = joint_axis_world(stage, prim)
         np.testing.assert_allclose(axis, art.axis, atol=1e-5)
@@ -68,10 +68,10 @@ def test_check_usd_catches_misaligned_frames_and_triangle_colliders(exported: di
     d = tmp_path / "usd"
     shutil.copytree(exported["usd"].parent, d)
     stage = Usd.Stage.Open(str(d / "scene.usda"))
-    UsdPhysics.Joint(stage.GetPrimAtPath("/World/door/joint")).GetLocalPos1Attr().Set(Gf.Vec3f(0.1, 0, 0))
-    piece = stage.GetPrimAtPath("/World/drawer/part/collisions/piece_0")
+    UsdPhysics.Joint(stage.GetPrimAtPath("/World/door/door_joint")).GetLocalPos1Attr().Set(Gf.Vec3f(0.1, 0, 0))
+    piece = stage.GetPrimAtPath("/World/drawer/drawer/collisions/piece_0")
     UsdPhysics.MeshCollisionAPI(piece).GetApproximationAttr().Set("none")
-    UsdPhysics.MassAPI(stage.GetPrimAtPath("/World/drawer/part")).GetMassAttr().Set(0.0)
+    UsdPhysics.MassAPI(stage.GetPrimAtPath("/World/drawer/drawer")).GetMassAttr().Set(0.0)
     stage.GetRootLayer().Save()
     problems = check_usd(d / "scene.usda")
     assert any("frame origins differ" in p for p in problems)
