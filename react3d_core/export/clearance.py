@@ -354,6 +354,50 @@ def box_conflicts(corners: np.ndarray, axes: np.ndarray, obstacles: Sequence[Obs
     return out
 
 
+def territory_plane(front_a: np.ndarray, normal_a: np.ndarray, front_b: np.ndarray, normal_b: np.ndarray,
+                    parallel_deg: float = 5.0) -> tuple[np.ndarray, float]:
+    """A plane between two neighbouring objects: (m, c) with A's front on the side m . x < c.
+
+    Fronts turned against each other (a corner, or two fronts whose estimated normals differ) share
+    the bisector of their planes, through the line where the planes meet, when it has each front on
+    its own side; otherwise (coplanar fronts side by side or stacked) the plane lies across the
+    direction from A's front to B's, in the middle of the gap between them."""
+    na = np.asarray(normal_a, float) / np.linalg.norm(normal_a)
+    nb = np.asarray(normal_b, float) / np.linalg.norm(normal_b)
+    ca, cb = front_a.mean(0), front_b.mean(0)
+    d = na - nb
+    if np.linalg.norm(d) > 2 * np.sin(np.radians(parallel_deg) / 2):
+        m = d / np.linalg.norm(d)
+        c = float(na @ ca - nb @ cb) / float(np.linalg.norm(d))
+        if m @ ca > c:
+            m, c = -m, -c
+        if np.mean(front_a @ m < c) >= 0.9 and np.mean(front_b @ m > c) >= 0.9:
+            return m, c
+    mean_n = na + nb
+    mean_n = mean_n / np.linalg.norm(mean_n) if np.linalg.norm(mean_n) > 1e-9 else na
+    m = (cb - ca) - ((cb - ca) @ mean_n) * mean_n
+    if np.linalg.norm(m) < 1e-9:
+        m = cb - ca
+    m = m / max(np.linalg.norm(m), 1e-12)
+    return m, float((np.max(front_a @ m) + np.min(front_b @ m)) / 2)
+
+
+def keep_side(pieces: Sequence[ConvexPiece], m: np.ndarray, c: float) -> tuple[list[ConvexPiece], int]:
+    """``pieces`` cut to the half-space m . x <= c (a piece left thinner than ``MIN_PIECE_M`` is dropped);
+    returns them and how many were cut or dropped."""
+    out, changed = [], 0
+    for p in pieces:
+        if float((p.vertices @ m).max()) <= c:
+            out.append(p)
+            continue
+        changed += 1
+        pts = clip_halfspace(p.vertices, m, c)
+        new = _piece(pts, p.source) if pts is not None else None
+        if new is not None:
+            out.append(new)
+    return out, changed
+
+
 def separate_at_rest(groups: Sequence[Sequence[ConvexPiece]], margin: float) -> tuple[list[list[ConvexPiece]], ClearStats]:
     """Pieces of different groups (parts) that overlap at rest: the smaller piece is cut back to clear
     the larger by ``margin`` (a fragment of one front lying on its neighbour yields, not the front)."""

@@ -33,10 +33,16 @@ class ConvexPiece:
     vertices: np.ndarray
     faces: np.ndarray
     source: str  # "component", "hull", "coacd", "box", "patch"
+    box: np.ndarray | None = None  # (15,) centre, rotation (3x3, row-major; columns are the box axes), extents: an exact box
 
     @property
     def volume(self) -> float:
         return float(trimesh.Trimesh(self.vertices, self.faces, process=False).volume)
+
+    def box_frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(centre, rotation, extents) of a box piece (writers emit it as a box primitive)."""
+        assert self.box is not None
+        return self.box[:3], self.box[3:12].reshape(3, 3), self.box[12:]
 
 
 def _pca_frame(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -124,11 +130,12 @@ def _coacd(comp: trimesh.Trimesh, max_pieces: int, min_thickness: float) -> list
 
 
 def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float
-               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """One slab box per group of triangles (grid cell of the centroid x dominant normal direction).
 
     Returns per group: corners (G,8,3), axes (G,3,3) (rows: normal, two in-plane axes), the
-    surface's own thickness along the normal (G,), and per triangle its group (T,). The normal
+    surface's own thickness along the normal (G,), per triangle its group (T,), and the boxes
+    (G,15) as ``ConvexPiece.box``. The normal
     points out of the surface (the side its faces face) and the slab lies behind the surface:
     its outer face is the outermost point of the surface, so a surface's collider never stands
     in front of it. In-plane extents below ``min_thickness`` are padded symmetrically."""
@@ -170,12 +177,14 @@ def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float
     unit = np.asarray(trimesh.creation.box(extents=(1.0, 1.0, 1.0)).vertices) + 0.5  # corners in [0, 1]^3
     local_corners = lo[:, None, :] + unit[None] * (hi - lo)[:, None, :]
     corners = mu[:, None, :] + np.einsum("gcj,gij->gci", local_corners, R)
-    return corners, np.transpose(R, (0, 2, 1)), thickness, g_tri
+    centre = mu + np.einsum("gij,gj->gi", R, (lo + hi) / 2)
+    boxes = np.concatenate([centre, R.reshape(G, 9), hi - lo], axis=1)
+    return corners, np.transpose(R, (0, 2, 1)), thickness, g_tri, boxes
 
 
-def _slab_pieces(corners: np.ndarray) -> list[ConvexPiece]:
+def _slab_pieces(corners: np.ndarray, boxes: np.ndarray) -> list[ConvexPiece]:
     faces = np.asarray(trimesh.creation.box(extents=(1.0, 1.0, 1.0)).faces)
-    return [ConvexPiece(c, faces, "patch") for c in corners]
+    return [ConvexPiece(c, faces, "patch", b) for c, b in zip(corners, boxes)]
 
 
 def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: float | None = None,
@@ -211,12 +220,12 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: f
     close: list[ConvexPiece] = []
     size = cell
     while len(tri):
-        corners, axes, thickness, g_tri = _fit_slabs(tri, n, size, min_thickness)
+        corners, axes, thickness, g_tri, boxes = _fit_slabs(tri, n, size, min_thickness)
         last = min_cell is None or size / 2 < min_cell
         near = box_conflicts(corners, axes, obstacles, margin) if len(obstacles) else np.zeros(len(corners), bool)
         split = np.zeros(len(corners), bool) if last else near | (thickness > flatness if flatness is not None else False)
-        out += _slab_pieces(corners[~split & ~near])
-        close += _slab_pieces(corners[~split & near])
+        out += _slab_pieces(corners[~split & ~near], boxes[~split & ~near])
+        close += _slab_pieces(corners[~split & near], boxes[~split & near])
         if last or not split.any():
             break
         sel = split[g_tri]
@@ -227,7 +236,7 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: f
     return out + close
 
 
-COLLISION_VERSION = "2"
+COLLISION_VERSION = "3"
 """Bump when convex_pieces / planar_patches change their output: it is part of the cache key."""
 
 
@@ -255,7 +264,8 @@ def cached_pieces(cache_dir: str | Path | None, kind: str, mesh: TriMesh, params
                 counts_v, counts_f = z["counts_v"], z["counts_f"]
                 vs = np.split(z["vertices"], np.cumsum(counts_v)[:-1]) if len(counts_v) else []
                 fs = np.split(z["faces"], np.cumsum(counts_f)[:-1]) if len(counts_f) else []
-                return [ConvexPiece(v, f, str(s)) for v, f, s in zip(vs, fs, z["sources"])]
+                boxes = z["boxes"] if "boxes" in z.files else np.full((len(vs), 15), np.nan)
+                return [ConvexPiece(v, f, str(s), None if np.isnan(b).any() else b) for v, f, s, b in zip(vs, fs, z["sources"], boxes)]
         except (OSError, ValueError, KeyError, zipfile.BadZipFile):
             pass  # unreadable: recompute below and overwrite
     pieces = compute()
@@ -268,5 +278,6 @@ def cached_pieces(cache_dir: str | Path | None, kind: str, mesh: TriMesh, params
                 counts_v=np.array([len(p.vertices) for p in pieces], np.int64),
                 counts_f=np.array([len(p.faces) for p in pieces], np.int64),
                 sources=np.array([p.source for p in pieces], dtype=str),
+                boxes=np.array([p.box if p.box is not None else np.full(15, np.nan) for p in pieces]).reshape(-1, 15),
             )
     return pieces

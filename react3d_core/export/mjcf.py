@@ -1,8 +1,8 @@
 """MJCF writer for MuJoCo: static background, per object a static base body and a moving part body.
 
 MuJoCo convexifies every mesh, so collision pieces are inline convex meshes (one geom each) and the
-static background collides through its planar patches; the textured OBJ visuals (group 1) do not
-collide. Joint frames match the URDF: the part body sits at the articulation origin.
+static background collides through its planar patches (box geoms; a patch cut back near a part is an
+inline convex mesh); the textured OBJ visuals (group 1) do not collide. Joint frames match the URDF: the part body sits at the articulation origin.
 
 Collision policy, stated in the file: every collision geom has ``contype="1" conaffinity="1"`` (a
 robot with the defaults collides with every part, carcass and the background); a part and its own
@@ -18,6 +18,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from ..atomic import write_text
 from ..config.export import ExportConfig
@@ -44,14 +45,15 @@ def _assets(link: Link, files: LinkFiles) -> list[str]:
     for k, (obj, png) in enumerate(zip(files.visuals, files.mjcf_textures)):
         n = f"{link.name}_visual_{k}"
         out += [
-            f'    <mesh name="{n}" file={quoteattr(obj)}/>',
+            f'    <mesh name="{n}" file={quoteattr(obj)} inertia="shell"/>',  # visual only: a flat scan has no volume
             f'    <texture name="{n}_tex" type="2d" file={quoteattr(png)}/>',
             f'    <material name="{n}_mat" texture="{n}_tex"/>',
         ]
     for k, piece in enumerate(link.collisions):
         out.append(_inline_mesh(f"{link.name}_col_{k}", piece, link.frame))
     for k, piece in enumerate(link.patches):
-        out.append(_inline_mesh(f"{link.name}_patch_{k}", piece, link.frame))
+        if piece.box is None:
+            out.append(_inline_mesh(f"{link.name}_patch_{k}", piece, link.frame))
     return out
 
 
@@ -62,8 +64,14 @@ def _geoms(link: Link, files: LinkFiles, indent: str) -> list[str]:
         out.append(f'{indent}<geom name="{n}" type="mesh" mesh="{n}" material="{n}_mat" class="visual"/>')
     for k in range(len(link.collisions)):
         out.append(f'{indent}<geom name="{link.name}_col_{k}" type="mesh" mesh="{link.name}_col_{k}" class="collision"/>')
-    for k in range(len(link.patches)):
-        out.append(f'{indent}<geom name="{link.name}_patch_{k}" type="mesh" mesh="{link.name}_patch_{k}" class="collision"/>')
+    for k, piece in enumerate(link.patches):
+        n = f"{link.name}_patch_{k}"
+        if piece.box is None:
+            out.append(f'{indent}<geom name="{n}" type="mesh" mesh="{n}" class="collision"/>')
+            continue
+        c, R, ext = piece.box_frame()
+        x, y, z, w = Rotation.from_matrix(R).as_quat()
+        out.append(f'{indent}<geom name="{n}" type="box" pos="{_v(c - link.frame)}" quat="{_v([w, x, y, z])}" size="{_v(ext / 2)}" class="collision"/>')
     return out
 
 

@@ -20,7 +20,8 @@ from ..data.mesh import TriMesh, load_mesh
 from ..data.parts import Articulation, InteractiveScene
 from ..errors import InputError
 from ..texture import TexturedMesh, bake_texture
-from .clearance import Obstacle, carve_faces, clear_paths, hull_obstacle, keep_clear, separate_at_rest, sweep_obstacles
+from .clearance import (Obstacle, carve_faces, clear_paths, gap, hull_obstacle, keep_clear, keep_side, piece_axes, separate_at_rest,
+                        sweep_obstacles, territory_plane)
 from .collision import ConvexPiece, cached_pieces, convex_pieces, planar_patches
 from .inertia import Inertial, inertial_from_pieces
 
@@ -92,10 +93,50 @@ class _Object:
     oid: str
     obj: object
     part_meshes: list[TriMesh]
-    part: list[ConvexPiece]
+    part: list[ConvexPiece]  # the front's pieces first (``n_front``), then the drawer box's
     base_mesh: TriMesh | None
     base: list[ConvexPiece] | None
+    n_front: int = 0
     sweep: list[Obstacle] = field(default_factory=list)
+
+    def pieces(self) -> list[ConvexPiece]:
+        return self.part + (self.base or [])
+
+
+def _near(a: list[ConvexPiece], b: list[ConvexPiece], margin: float) -> bool:
+    """Whether any piece of ``a`` comes within ``margin`` of one of ``b`` (separating-axis test)."""
+    for p in a:
+        for q in b:
+            if np.any(p.vertices.min(0) > q.vertices.max(0) + margin) or np.any(q.vertices.min(0) > p.vertices.max(0) + margin):
+                continue
+            ob = hull_obstacle(q.vertices, "", "rest")
+            if ob is not None and gap(p.vertices, piece_axes(p), ob)[0] < margin:
+                return True
+    return False
+
+
+def split_territories(objects: list[_Object], margin: float) -> int:
+    """Neighbours whose pieces (front, drawer box, carcass) meet are each cut back to their own side
+    of a plane between their fronts (``clearance.territory_plane``), ``margin / 2`` off it: two
+    carcasses estimated at an angle, or a drawer box reaching behind its neighbour, then share the
+    disputed space instead of both claiming it. Returns the number of pieces cut."""
+    cut = 0
+    for i, a in enumerate(objects):
+        for b in objects[i + 1 :]:
+            if not a.n_front or not b.n_front or not _near(a.pieces(), b.pieces(), margin):
+                continue
+            fa = np.vstack([p.vertices for p in a.part[: a.n_front]])
+            fb = np.vstack([p.vertices for p in b.part[: b.n_front]])
+            m, c = territory_plane(fa, np.asarray(a.obj.front_normal), fb, np.asarray(b.obj.front_normal))
+            for o, (mm, cc) in ((a, (m, c - margin / 2)), (b, (-m, -c - margin / 2))):
+                front, k1 = keep_side(o.part[: o.n_front], mm, cc)
+                inner, k2 = keep_side(o.part[o.n_front :], mm, cc)
+                o.part, o.n_front = front + inner, len(front)
+                if o.base is not None:
+                    o.base, k3 = keep_side(o.base, mm, cc)
+                    k2 += k3
+                cut += k1 + k2
+    return cut
 
 
 def obstacle_digest(obstacles: list[Obstacle]) -> str:
@@ -111,13 +152,15 @@ def separate_colliders(objects: list[_Object], config: ExportConfig) -> tuple[li
     """Cut part and carcass pieces back so that no pair overlaps at rest and nothing static stands in a
     part's path (``clearance`` module); returns the obstacles the background must keep clear of.
 
-    Order of precedence: parts over carcasses and background (a part is what a robot handles; the
-    carcass is estimated); of two part pieces overlapping at rest the smaller yields; of two carcasses
+    Neighbours that meet first split the disputed space (``split_territories``). Then: parts over
+    carcasses and background (a part is what a robot handles; the carcass is estimated); of two
+    part pieces still overlapping at rest the smaller yields; of two carcasses
     the earlier object's. Where a part's path meets another part at rest, the cut that removes less
     volume is made, up to ``part_trim_max_fraction`` of a piece (``clearance.clear_paths``); deeper
     conflicts are left to the joint limits."""
     m = config.collider_clearance_m
     stats = {"parts_cut": 0, "carcass_cut": 0, "pieces_dropped": 0, "part_conflicts_left": 0}
+    stats["territory_cut"] = split_territories(objects, m)
     parts, st = separate_at_rest([o.part for o in objects], m)
     stats["parts_cut"] += st.cut
     stats["pieces_dropped"] += st.dropped
@@ -177,8 +220,10 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
         moving = [m for m in (part, _mesh(root, obj.inner_mesh)) if m is not None]
         budget = max(1, config.max_convex_hulls // len(moving))
         base = _mesh(root, obj.base_mesh)
-        objects.append(_Object(oid, obj, moving, [p for m in moving for p in pieces_of(m, budget)], base,
-                               pieces_of(base, config.max_convex_hulls) if base is not None else None))
+        front = pieces_of(part, budget)
+        inner = pieces_of(moving[1], budget) if len(moving) > 1 else []
+        objects.append(_Object(oid, obj, moving, front + inner, base,
+                               pieces_of(base, config.max_convex_hulls) if base is not None else None, n_front=len(front)))
     obstacles, stats = separate_colliders(objects, config)
     margin = config.collider_clearance_m
     keep, fragments = carve_faces(bg.vertices, bg.faces, obstacles, margin, 4 * config.background_patch_min_m)
