@@ -7,15 +7,20 @@ part jams before it moves. Here every collider is made to keep ``margin`` away f
 must leave free:
 
 - an ``Obstacle`` is a convex region (vertices, outward face normals): one part piece at rest, the
-  hull of a part at two consecutive poses along its joint (its swept volume, in pieces), or a
-  carcass's solid hull (its cavity is free space for everything but the part that moves in it);
+  hull of a piece at two consecutive poses along its joint (``sweep_obstacles``: its swept volume,
+  in pieces), or a carcass's solid hull (its cavity is free space for everything but the part that
+  moves in it);
 - ``gap`` is a separating-axis lower bound of the distance between a convex piece and an obstacle
   (face normals of both; edge-edge axes are left out, so a reported overlap may be a near miss: the
   test errs towards carving, never towards an overlap);
-- ``keep_clear`` clips a convex piece by the one half-space, among those axes, that keeps most of
+- ``keep_clear`` cuts a convex piece by the one half-space, among those axes, that keeps most of
   its volume while clearing the obstacle by ``margin`` (the result stays convex; a piece left
   thinner than ``MIN_PIECE_M`` is dropped);
-- ``face_conflicts`` flags the triangles of a static mesh that come within ``margin`` of an obstacle.
+- ``territory_plane`` / ``keep_side``: two neighbours that meet split the space between their
+  fronts; ``separate_at_rest``: of two part pieces overlapping at rest the smaller yields;
+  ``clear_paths``: where a part's path meets another part, the cheaper of the two cuts;
+- ``face_conflicts`` / ``carve_faces`` flag the triangles of a static mesh that come within
+  ``margin`` of an obstacle (splitting big ones so only what is in the way goes).
 """
 
 from __future__ import annotations
@@ -93,11 +98,24 @@ def hull_obstacle(points: np.ndarray, owner: str, kind: str, grow: float = 0.0) 
 
 
 def piece_axes(piece: ConvexPiece) -> np.ndarray:
-    """Face-normal directions of a convex piece (3 for a box)."""
-    v, f = piece.vertices, piece.faces
-    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    keep = np.linalg.norm(n, axis=1) > 1e-12
-    return unique_axes(n[keep], tol=1e-5)
+    """Face-normal directions of a convex piece (3 for a box; computed once per piece)."""
+    return piece.axes
+
+
+class ObstacleSet:
+    """Obstacles with their bounding boxes in arrays, so a piece tests only those near it."""
+
+    def __init__(self, obstacles: Sequence[Obstacle]) -> None:
+        self.items = list(obstacles)
+        self.lo = np.array([o.lo - o.grow for o in self.items]).reshape(-1, 3)
+        self.hi = np.array([o.hi + o.grow for o in self.items]).reshape(-1, 3)
+
+    def near(self, lo: np.ndarray, hi: np.ndarray, pad: float) -> list[Obstacle]:
+        """Obstacles whose (grown) box comes within ``pad`` of [lo, hi], in their order."""
+        if not self.items:
+            return []
+        ok = np.all(self.lo <= hi + pad, axis=1) & np.all(self.hi >= lo - pad, axis=1)
+        return [self.items[i] for i in np.flatnonzero(ok)]
 
 
 def sweep_obstacles(pieces: Sequence[ConvexPiece], art: Articulation, owner: str, margin: float) -> list[Obstacle]:
@@ -128,12 +146,6 @@ def sweep_obstacles(pieces: Sequence[ConvexPiece], art: Articulation, owner: str
             if ob is not None:
                 out.append(ob)
     return out
-
-
-def rest_obstacles(pieces: Sequence[ConvexPiece], owner: str) -> list[Obstacle]:
-    """Each piece at rest as its own obstacle (a drawer's open box stays open)."""
-    out = [hull_obstacle(p.vertices, owner, "rest") for p in pieces]
-    return [o for o in out if o is not None]
 
 
 def gap(vertices: np.ndarray, axes: np.ndarray, ob: Obstacle) -> tuple[float, np.ndarray, float]:
@@ -202,42 +214,28 @@ def _volume(points: np.ndarray) -> float:
     return float(h.volume) if h is not None else 0.0
 
 
-def clip_clear(piece: ConvexPiece, ob: Obstacle, margin: float, candidates: int = 4,
-               max_trim: float | None = None) -> tuple[ConvexPiece | None, float]:
+def clip_clear(piece: ConvexPiece, ob: Obstacle, margin: float, candidates: int = 2) -> ConvexPiece | None:
     """``piece`` cut back by one plane so that it clears ``ob`` by ``margin + ob.grow``: of the tested
-    axes, the cut that keeps the most volume. Returns (piece or None if nothing is left, depth cut).
-    ``max_trim``: refuse cuts deeper than this (returns the piece unchanged and the depth needed)."""
+    axes (both shapes' face normals), the cut that keeps the most volume (the ``candidates`` best by
+    the share of the piece's extent they keep are cut exactly). None if nothing is left."""
     need = margin + ob.grow
     v = piece.vertices
     A = np.vstack([piece_axes(piece), ob.normals])
     pp, oo = v @ A.T, ob.vertices @ A.T
     pmin, pmax, omin, omax = pp.min(0), pp.max(0), oo.min(0), oo.max(0)
     span = np.maximum(pmax - pmin, 1e-12)
-    # option 1: keep a . x <= omin - need; option 2: keep a . x >= omax + need
+    # side 1 keeps a . x <= omin - need, side 2 keeps a . x >= omax + need
     keep1 = np.clip((omin - need - pmin) / span, 0, 1)
     keep2 = np.clip((pmax - (omax + need)) / span, 0, 1)
-    cut1, cut2 = pmax - (omin - need), (omax + need) - pmin
-    opts = [(keep1[k], k, 1) for k in range(len(A))] + [(keep2[k], k, 2) for k in range(len(A))]
-    opts.sort(key=lambda o: -o[0])
-    best: tuple[float, np.ndarray | None, float] = (-1.0, None, 0.0)
+    opts = sorted([(keep1[k], k, 1) for k in range(len(A))] + [(keep2[k], k, 2) for k in range(len(A))], key=lambda o: -o[0])
+    best: tuple[float, np.ndarray | None] = (-1.0, None)
     for frac, k, side in opts[:candidates]:
-        depth = float(cut1[k] if side == 1 else cut2[k])
         if frac <= 0:
             continue
         pts = clip_halfspace(v, A[k], omin[k] - need) if side == 1 else clip_halfspace(v, -A[k], -(omax[k] + need))
-        if pts is None:
-            continue
-        vol = _volume(pts)
-        if vol > best[0]:
-            best = (vol, pts, depth)
-    if best[1] is None:
-        depth = float(min(cut1.min(), cut2.min()))
-        if max_trim is not None and depth > max_trim:
-            return piece, depth
-        return None, depth
-    if max_trim is not None and best[2] > max_trim:
-        return piece, best[2]
-    return _piece(best[1], piece.source), best[2]
+        if pts is not None and (vol := _volume(pts)) > best[0]:
+            best = (vol, pts)
+    return None if best[1] is None else _piece(best[1], piece.source)
 
 
 def _overlaps(lo: np.ndarray, hi: np.ndarray, ob: Obstacle, pad: float) -> bool:
@@ -246,44 +244,30 @@ def _overlaps(lo: np.ndarray, hi: np.ndarray, ob: Obstacle, pad: float) -> bool:
 
 @dataclass
 class ClearStats:
-    """What keeping clear did: pieces cut, dropped, and conflicts left (too deep to trim)."""
+    """What keeping clear did: pieces cut, dropped, and conflicts left (a cut too large to make)."""
 
     cut: int = 0
     dropped: int = 0
     left: int = 0
-    deepest_left: float = 0.0
-
-    def add(self, other: "ClearStats") -> None:
-        self.cut += other.cut
-        self.dropped += other.dropped
-        self.left += other.left
-        self.deepest_left = max(self.deepest_left, other.deepest_left)
 
 
-def keep_clear(pieces: Sequence[ConvexPiece], obstacles: Sequence[Obstacle], margin: float,
-               max_trim: float | None = None) -> tuple[list[ConvexPiece], ClearStats]:
+def keep_clear(pieces: Sequence[ConvexPiece], obstacles: Sequence[Obstacle] | ObstacleSet, margin: float
+               ) -> tuple[list[ConvexPiece], ClearStats]:
     """Cut each piece back until it clears every obstacle by ``margin`` (see ``clip_clear``).
 
     One pass suffices: a half-space cut only shrinks a piece, so one that cleared an earlier
-    obstacle stays clear of it. ``max_trim``: cuts deeper than this are refused and counted as left."""
+    obstacle stays clear of it."""
+    obs = obstacles if isinstance(obstacles, ObstacleSet) else ObstacleSet(obstacles)
     stats = ClearStats()
     out: list[ConvexPiece] = []
     for piece in pieces:
         cur: ConvexPiece | None = piece
-        for ob in obstacles:
+        for ob in obs.near(piece.vertices.min(0), piece.vertices.max(0), margin):
             need = margin + ob.grow
             v = cur.vertices
-            if not _overlaps(v.min(0), v.max(0), ob, need):
+            if not _overlaps(v.min(0), v.max(0), ob, need) or gap(v, piece_axes(cur), ob)[0] >= need - 1e-9:
                 continue
-            g, _, _ = gap(v, piece_axes(cur), ob)
-            if g >= need - 1e-9:
-                continue
-            new, depth = clip_clear(cur, ob, margin, max_trim=max_trim)
-            if new is cur:  # refused: deeper than max_trim
-                stats.left += 1
-                stats.deepest_left = max(stats.deepest_left, depth)
-                continue
-            cur = new
+            cur = clip_clear(cur, ob, margin)
             if cur is None:
                 break
         if cur is None:
@@ -422,7 +406,7 @@ def separate_at_rest(groups: Sequence[Sequence[ConvexPiece]], margin: float) -> 
         ob = hull_obstacle(pl.vertices, str(gl), "rest")
         if ob is None or gap(ps.vertices, piece_axes(ps), ob)[0] >= margin - 1e-9:
             continue
-        new, _ = clip_clear(ps, ob, margin)
+        new = clip_clear(ps, ob, margin)
         out[gs][is_] = new  # type: ignore[call-overload]
         (cut if new is not None else dropped).add((gs, is_))
     stats.cut = len(cut - dropped)
@@ -440,13 +424,15 @@ def _loss(piece: ConvexPiece, new: ConvexPiece | None) -> float:
 
 
 def clear_paths(parts: Sequence[Sequence[ConvexPiece]], arts: Sequence[Articulation], margin: float,
-                max_fraction: float, fragment: float = 0.02) -> tuple[list[list[ConvexPiece]], ClearStats]:
+                max_fraction: float, fragment: float = 0.02) -> tuple[list[list[ConvexPiece]], list[list[Obstacle]], ClearStats]:
     """Each part driven alone must not sweep through another part at rest.
 
     For a moving piece p whose path meets a resting piece q, either q is cut out of p's path or p is
     cut clear of q's reverse path (q as the moving part sees it), whichever removes less volume. A
     cut is refused when it removes more than ``max_fraction`` of the piece (unless the piece is a
-    fragment: under ``fragment`` of its part's volume): then the conflict is left (a joint limit)."""
+    fragment: under ``fragment`` of its part's volume): then the conflict is left (a joint limit).
+    Returns the pieces, each part's swept volume and counts. A piece cut as the resting one after its
+    own path was traced keeps that path: it contains the smaller piece's, so carving around it is safe."""
     out = [list(g) for g in parts]
     total = [sum(p.volume for p in g) for g in out]
     stats = ClearStats()
@@ -460,10 +446,12 @@ def clear_paths(parts: Sequence[Sequence[ConvexPiece]], arts: Sequence[Articulat
     flat = [(g, i) for g in range(len(out)) for i in range(len(out[g]))]
     lo_all = np.array([out[g][i].vertices.min(0) for g, i in flat]).reshape(-1, 3)
     hi_all = np.array([out[g][i].vertices.max(0) for g, i in flat]).reshape(-1, 3)
+    sweeps: list[list[list[Obstacle]]] = [[[] for _ in g] for g in out]
     for ga, art in enumerate(arts):
         for ia in range(len(out[ga])):
             p = out[ga][ia]
             sweep = sweep_obstacles([p], art, str(ga), margin) if p is not None else []
+            sweeps[ga][ia] = sweep
             if not sweep:
                 continue
             lo, hi = np.min([o.lo for o in sweep], 0), np.max([o.hi for o in sweep], 0)
@@ -489,9 +477,12 @@ def clear_paths(parts: Sequence[Sequence[ConvexPiece]], arts: Sequence[Articulat
                 if (g, i) == (ga, ia):
                     p = new
                     sweep = sweep_obstacles([p], art, str(ga), margin) if p is not None else []
+                    sweeps[ga][ia] = sweep
     stats.cut = len(changed - dropped)
     stats.dropped = len(dropped)
-    return [[p for p in g if p is not None] for g in out], stats
+    final = [[p for p in g if p is not None] for g in out]
+    paths = [[ob for i, p in enumerate(g) if p is not None for ob in sweeps[k][i]] for k, g in enumerate(out)]
+    return final, paths, stats
 
 
 def _split4(tri: np.ndarray) -> np.ndarray:

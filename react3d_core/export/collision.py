@@ -15,6 +15,7 @@ import hashlib
 import zipfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -35,9 +36,18 @@ class ConvexPiece:
     source: str  # "component", "hull", "coacd", "box", "patch"
     box: np.ndarray | None = None  # (15,) centre, rotation (3x3, row-major; columns are the box axes), extents: an exact box
 
-    @property
+    @cached_property
     def volume(self) -> float:
         return float(trimesh.Trimesh(self.vertices, self.faces, process=False).volume)
+
+    @cached_property
+    def axes(self) -> np.ndarray:
+        """Its face-normal directions, duplicates and opposites removed (3 for a box)."""
+        from .clearance import unique_axes
+
+        v, f = self.vertices, self.faces
+        n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+        return unique_axes(n[np.linalg.norm(n, axis=1) > 1e-12], tol=1e-5)
 
     def box_frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(centre, rotation, extents) of a box piece (writers emit it as a box primitive)."""
@@ -203,7 +213,7 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: f
     large, down to ``min_cell``; slabs still too close are then cut back (``clearance.keep_clear``).
     ``faces``: indices of the faces to use (default all); ``extra``: more triangles (k,3,3).
     """
-    from .clearance import box_conflicts, keep_clear
+    from .clearance import ObstacleSet, box_conflicts, keep_clear
 
     f = mesh.faces if faces is None else mesh.faces[np.asarray(faces, np.int64)]
     tri = mesh.vertices[f]
@@ -232,7 +242,7 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: f
         tri, n = tri[sel], n[sel]
         size /= 2
     if close:
-        close, _ = keep_clear(close, obstacles, margin)
+        close, _ = keep_clear(close, ObstacleSet(obstacles), margin)
     return out + close
 
 

@@ -20,8 +20,8 @@ from ..data.mesh import TriMesh, load_mesh
 from ..data.parts import Articulation, InteractiveScene
 from ..errors import InputError
 from ..texture import TexturedMesh, bake_texture
-from .clearance import (Obstacle, carve_faces, clear_paths, gap, hull_obstacle, keep_clear, keep_side, piece_axes, separate_at_rest,
-                        sweep_obstacles, territory_plane)
+from .clearance import (Obstacle, ObstacleSet, carve_faces, clear_paths, gap, hull_obstacle, keep_clear, keep_side, piece_axes, separate_at_rest,
+                        territory_plane)
 from .collision import ConvexPiece, cached_pieces, convex_pieces, planar_patches
 from .inertia import Inertial, inertial_from_pieces
 
@@ -103,8 +103,16 @@ class _Object:
         return self.part + (self.base or [])
 
 
+def _box(pieces: list[ConvexPiece]) -> tuple[np.ndarray, np.ndarray]:
+    v = np.vstack([p.vertices for p in pieces]) if pieces else np.zeros((1, 3))
+    return v.min(0), v.max(0)
+
+
 def _near(a: list[ConvexPiece], b: list[ConvexPiece], margin: float) -> bool:
     """Whether any piece of ``a`` comes within ``margin`` of one of ``b`` (separating-axis test)."""
+    (alo, ahi), (blo, bhi) = _box(a), _box(b)
+    if np.any(alo > bhi + margin) or np.any(blo > ahi + margin):
+        return False
     for p in a:
         for q in b:
             if np.any(p.vertices.min(0) > q.vertices.max(0) + margin) or np.any(q.vertices.min(0) > p.vertices.max(0) + margin):
@@ -166,25 +174,27 @@ def separate_colliders(objects: list[_Object], config: ExportConfig) -> tuple[li
     stats["pieces_dropped"] += st.dropped
     for o, pieces in zip(objects, parts):
         o.part = pieces
-    parts, st = clear_paths([o.part for o in objects], [o.obj.articulation for o in objects], m, config.part_trim_max_fraction)
+    parts, paths, st = clear_paths([o.part for o in objects], [o.obj.articulation for o in objects], m, config.part_trim_max_fraction)
     stats["parts_cut"] += st.cut
     stats["pieces_dropped"] += st.dropped
     stats["part_conflicts_left"] = st.left
-    for o, pieces in zip(objects, parts):
-        o.part = pieces
-        o.sweep = sweep_obstacles(o.part, o.obj.articulation, o.oid, m)
-    sweeps = [ob for o in objects for ob in o.sweep]
+    for o, pieces, path in zip(objects, parts, paths):
+        o.part, o.sweep = pieces, path
+    sweeps = ObstacleSet([ob for o in objects for ob in o.sweep])
     carcasses: list[Obstacle] = []
     for o in objects:  # carcasses: out of every path and of earlier carcasses
         if o.base is None:
             continue
-        o.base, st = keep_clear(o.base, sweeps + carcasses, m)
+        o.base, st = keep_clear(o.base, sweeps, m)
+        o.base, st2 = keep_clear(o.base, carcasses, m)
+        st.cut += st2.cut
+        st.dropped += st2.dropped
         stats["carcass_cut"] += st.cut
         stats["pieces_dropped"] += st.dropped
         hull = hull_obstacle(np.vstack([p.vertices for p in o.base]), o.oid, "carcass") if o.base else None
         if hull is not None:
             carcasses.append(hull)
-    return sweeps + carcasses, stats
+    return sweeps.items + carcasses, stats
 
 
 def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportConfig | None = None,
