@@ -38,6 +38,11 @@ class ExportConfig(StageConfig):
         description="Smallest patch cell (m): a patch near a part's path or a carcass, or spanning several parallel surfaces, is refitted "
         "in cells half as large down to this, so the background hugs the gaps around fronts instead of bridging them.",
     )
+    background_slab_m: float = Field(
+        0.02, gt=0,
+        description="MJCF/URDF background patches are slabs this thick (m) behind their surface: a slab cut back near a part (the floor under "
+        "a door's swing) still leaves a surface, and a fast body does not tunnel through a wall.",
+    )
     background_patch_flatness_m: float = Field(
         0.02, gt=0, description="A background patch whose faces lie further apart than this (m) along its normal (a front and the wall behind it) is split.",
     )

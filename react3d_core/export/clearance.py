@@ -8,8 +8,8 @@ must leave free:
 
 - an ``Obstacle`` is a convex region (vertices, outward face normals): one part piece at rest, the
   hull of a piece at two consecutive poses along its joint (``sweep_obstacles``: its swept volume,
-  in pieces), or a carcass's solid hull (its cavity is free space for everything but the part that
-  moves in it);
+  in pieces), a carcass's solid hull (other carcasses keep out of it) or its cavity
+  (``cavity_obstacle``: the background keeps out of it);
 - ``gap`` is a separating-axis lower bound of the distance between a convex piece and an obstacle
   (face normals of both; edge-edge axes are left out, so a reported overlap may be a near miss: the
   test errs towards carving, never towards an overlap);
@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import trimesh
-from scipy.spatial import ConvexHull
+from scipy.spatial import ConvexHull, HalfspaceIntersection
 from scipy.spatial import QhullError
 
 from ..data.parts import Articulation
@@ -53,7 +53,7 @@ class Obstacle:
     hi: np.ndarray
     grow: float  # extra distance to keep (the chord error of a swept arc)
     owner: str  # object id of the part or carcass it stands for
-    kind: str  # "rest", "sweep", "carcass"
+    kind: str  # "rest", "sweep", "carcass", "cavity"
 
     @property
     def vmin(self) -> np.ndarray:
@@ -148,6 +148,28 @@ def sweep_obstacles(pieces: Sequence[ConvexPiece], art: Articulation, owner: str
     return out
 
 
+def cavity_obstacle(walls: Sequence[ConvexPiece], owner: str) -> Obstacle | None:
+    """The free space inside a carcass: the hull of its walls, each face moved inwards by the walls'
+    thickness (the median of their thinnest extents). What stands there blocks the cavity; what only
+    touches the walls from outside meets a static body it never collides with."""
+    if not walls:
+        return None
+    h = _hull(np.vstack([p.vertices for p in walls]))
+    if h is None:
+        return None
+    t = float(np.median([np.ptp(p.vertices @ p.axes.T, axis=0).min() for p in walls]))
+    eq = h.equations.copy()
+    eq[:, 3] += t  # n . x + d <= -t: t inside every face
+    centre = h.points[h.vertices].mean(0)
+    if np.any(eq[:, :3] @ centre + eq[:, 3] >= 0):
+        return None  # thinner than its walls: no cavity
+    try:
+        pts = HalfspaceIntersection(eq, centre).intersections
+    except QhullError:
+        return None
+    return hull_obstacle(pts, owner, "cavity")
+
+
 def gap(vertices: np.ndarray, axes: np.ndarray, ob: Obstacle) -> tuple[float, np.ndarray, float]:
     """(separation, axis, side) of a convex point set and an obstacle along the best tested axis.
 
@@ -228,14 +250,35 @@ def clip_clear(piece: ConvexPiece, ob: Obstacle, margin: float, candidates: int 
     keep1 = np.clip((omin - need - pmin) / span, 0, 1)
     keep2 = np.clip((pmax - (omax + need)) / span, 0, 1)
     opts = sorted([(keep1[k], k, 1) for k in range(len(A))] + [(keep2[k], k, 2) for k in range(len(A))], key=lambda o: -o[0])
-    best: tuple[float, np.ndarray | None] = (-1.0, None)
+    best: tuple[float, np.ndarray | None, int] = (-1.0, None, -1)
     for frac, k, side in opts[:candidates]:
         if frac <= 0:
             continue
         pts = clip_halfspace(v, A[k], omin[k] - need) if side == 1 else clip_halfspace(v, -A[k], -(omax[k] + need))
         if pts is not None and (vol := _volume(pts)) > best[0]:
-            best = (vol, pts)
-    return None if best[1] is None else _piece(best[1], piece.source)
+            best = (vol, pts, k)
+    if best[1] is None:
+        return None
+    if piece.box is not None:  # a box cut across (nearly) one of its own axes stays a box, if it still clears
+        _, R, _ = piece.box_frame()
+        if np.max(np.abs(R.T @ A[best[2]])) > 1 - 1e-6:
+            box = _box_piece(best[1], R, piece.source)
+            if box is None or gap(box.vertices, R.T, ob)[0] >= need - 1e-6:
+                return box
+    return _piece(best[1], piece.source)
+
+
+def _box_piece(points: np.ndarray, R: np.ndarray, source: str) -> ConvexPiece | None:
+    """The box with axes ``R`` (columns) bounding ``points``; None when thinner than ``MIN_PIECE_M``."""
+    local = points @ R
+    lo, hi = local.min(0), local.max(0)
+    if np.min(hi - lo) < MIN_PIECE_M:
+        return None
+    unit = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)], float)
+    corners = (lo + unit * (hi - lo)) @ R.T
+    hull = trimesh.Trimesh(corners, process=False).convex_hull
+    box = np.concatenate([R @ ((lo + hi) / 2), R.reshape(9), hi - lo])
+    return ConvexPiece(np.asarray(hull.vertices), np.asarray(hull.faces), source, box)
 
 
 def _overlaps(lo: np.ndarray, hi: np.ndarray, ob: Obstacle, pad: float) -> bool:

@@ -139,7 +139,7 @@ def _coacd(comp: trimesh.Trimesh, max_pieces: int, min_thickness: float) -> list
     return [convex_piece(np.asarray(v), min_thickness, "coacd") for v, _ in parts]
 
 
-def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float
+def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float, slab: float
                ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """One slab box per group of triangles (grid cell of the centroid x dominant normal direction).
 
@@ -148,7 +148,8 @@ def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float
     (G,15) as ``ConvexPiece.box``. The normal
     points out of the surface (the side its faces face) and the slab lies behind the surface:
     its outer face is the outermost point of the surface, so a surface's collider never stands
-    in front of it. In-plane extents below ``min_thickness`` are padded symmetrically."""
+    in front of it, and is at least ``slab`` thick. In-plane extents below ``min_thickness`` are padded
+    symmetrically."""
     axis = np.argmax(np.abs(n), axis=1)
     direction = axis * 2 + (n[np.arange(len(n)), axis] > 0)
     cells = np.floor(tri.mean(1) / cell).astype(np.int64)
@@ -180,7 +181,7 @@ def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float
     lo = np.minimum.reduceat(local[order], starts, axis=0)
     hi = np.maximum.reduceat(local[order], starts, axis=0)
     thickness = hi[:, 0] - lo[:, 0]
-    lo[:, 0] = np.minimum(lo[:, 0], hi[:, 0] - min_thickness)  # behind the surface
+    lo[:, 0] = np.minimum(lo[:, 0], hi[:, 0] - slab)  # behind the surface
     pad = np.maximum(min_thickness - (hi[:, 1:] - lo[:, 1:]), 0) / 2
     lo[:, 1:] -= pad
     hi[:, 1:] += pad
@@ -199,18 +200,20 @@ def _slab_pieces(corners: np.ndarray, boxes: np.ndarray) -> list[ConvexPiece]:
 
 def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: float | None = None,
                    flatness: float | None = None, obstacles: Sequence = (), margin: float = 0.0,
-                   faces: np.ndarray | None = None, extra: np.ndarray | None = None) -> list[ConvexPiece]:
+                   faces: np.ndarray | None = None, extra: np.ndarray | None = None, slab: float | None = None) -> list[ConvexPiece]:
     """Static background for engines that convexify every collision mesh (MuJoCo, PyBullet child links).
 
     Faces are grouped by the grid cell of their centroid and by dominant normal direction (+-x, +-y,
-    +-z); each group becomes a slab box behind its surface (at least ``min_thickness`` thick), so
+    +-z); each group becomes a slab box behind its surface (at least ``slab`` thick, default
+    ``min_thickness``), so
     floors and walls become slabs and a corner never becomes a solid wedge. All groups are fitted
     at once (batched covariance / eigh / segment min-max).
 
     Refinement (``min_cell`` given): a slab thicker than ``flatness`` (several parallel surfaces in
-    one cell: a front and the wall behind it) or within ``margin`` of an obstacle
-    (``clearance.Obstacle``: a part's path, a carcass) is refitted from its faces in cells half as
-    large, down to ``min_cell``; slabs still too close are then cut back (``clearance.keep_clear``).
+    one cell: a front and the wall behind it) is refitted from its faces in cells half as large, down
+    to 4 x ``min_cell``; one within ``margin`` of an obstacle (``clearance.Obstacle``: a part's path, a
+    cavity) is cut back (``clearance.keep_clear``) if that keeps ``REFINE_KEEP`` of it, else refitted
+    too (at ``min_cell``, cut back whatever it keeps).
     ``faces``: indices of the faces to use (default all); ``extra``: more triangles (k,3,3).
     """
     from .clearance import ObstacleSet, box_conflicts, keep_clear
@@ -227,23 +230,33 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: f
     if not len(tri):
         return []
     out: list[ConvexPiece] = []
-    close: list[ConvexPiece] = []
+    obs = ObstacleSet(obstacles)
     size = cell
     while len(tri):
-        corners, axes, thickness, g_tri, boxes = _fit_slabs(tri, n, size, min_thickness)
+        corners, axes, thickness, g_tri, boxes = _fit_slabs(tri, n, size, min_thickness, min_thickness if slab is None else slab)
         last = min_cell is None or size / 2 < min_cell
+        # parallel surfaces are told apart down to 4 x min_cell (a front frame and the wall behind it);
+        # only obstacles refine further (a slab standing across a gap that a part moves through)
+        split = np.zeros(len(corners), bool) if last or flatness is None or size / 2 < 4 * min_cell else thickness > flatness
         near = box_conflicts(corners, axes, obstacles, margin) if len(obstacles) else np.zeros(len(corners), bool)
-        split = np.zeros(len(corners), bool) if last else near | (thickness > flatness if flatness is not None else False)
         out += _slab_pieces(corners[~split & ~near], boxes[~split & ~near])
-        close += _slab_pieces(corners[~split & near], boxes[~split & near])
+        for g in np.flatnonzero(near & ~split):  # cut back; refine instead where a cut would lose much
+            (piece,) = _slab_pieces(corners[g : g + 1], boxes[g : g + 1])
+            cut, _ = keep_clear([piece], obs, margin)
+            if last or sum(c.volume for c in cut) >= REFINE_KEEP * piece.volume:
+                out += cut
+            else:
+                split[g] = True
         if last or not split.any():
             break
         sel = split[g_tri]
         tri, n = tri[sel], n[sel]
         size /= 2
-    if close:
-        close, _ = keep_clear(close, ObstacleSet(obstacles), margin)
-    return out + close
+    return out
+
+
+REFINE_KEEP = 0.7
+"""A background slab near an obstacle is cut back when that keeps this share of it, else refitted in smaller cells."""
 
 
 COLLISION_VERSION = "3"

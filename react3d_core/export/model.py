@@ -17,10 +17,10 @@ import numpy as np
 
 from ..config.export import ExportConfig
 from ..data.mesh import TriMesh, load_mesh
-from ..data.parts import Articulation, InteractiveScene
+from ..data.parts import Articulation, InteractiveObject, InteractiveScene
 from ..errors import InputError
 from ..texture import TexturedMesh, bake_texture
-from .clearance import (Obstacle, ObstacleSet, carve_faces, clear_paths, gap, hull_obstacle, keep_clear, keep_side, piece_axes, separate_at_rest,
+from .clearance import (Obstacle, ObstacleSet, carve_faces, cavity_obstacle, clear_paths, gap, hull_obstacle, keep_clear, keep_side, piece_axes, separate_at_rest,
                         territory_plane)
 from .collision import ConvexPiece, cached_pieces, convex_pieces, planar_patches
 from .inertia import Inertial, inertial_from_pieces
@@ -73,7 +73,7 @@ class SceneModel:
     scene_id: str
     links: list[Link]
     joints: list[Joint]
-    clearance: dict[str, float] = field(default_factory=dict)  # what separating the colliders did (counts, deepest conflict left)
+    clearance: dict[str, float] = field(default_factory=dict)  # what separating the colliders did (pieces cut, dropped, conflicts left)
 
     def link(self, name: str) -> Link:
         return next(link for link in self.links if link.name == name)
@@ -91,7 +91,7 @@ class _Object:
     """One object while its colliders are being separated."""
 
     oid: str
-    obj: object
+    obj: InteractiveObject
     part_meshes: list[TriMesh]
     part: list[ConvexPiece]  # the front's pieces first (``n_front``), then the drawer box's
     base_mesh: TriMesh | None
@@ -156,9 +156,11 @@ def obstacle_digest(obstacles: list[Obstacle]) -> str:
     return h.hexdigest()[:16]
 
 
-def separate_colliders(objects: list[_Object], config: ExportConfig) -> tuple[list[Obstacle], dict[str, float]]:
+def separate_colliders(objects: list[_Object], config: ExportConfig
+                       ) -> tuple[list[Obstacle], list[Obstacle], list[Obstacle], dict[str, float]]:
     """Cut part and carcass pieces back so that no pair overlaps at rest and nothing static stands in a
-    part's path (``clearance`` module); returns the obstacles the background must keep clear of.
+    part's path (``clearance`` module); returns the obstacles the background is carved around: the
+    parts' swept volumes, the carcasses' hulls and their cavities, and counts.
 
     Neighbours that meet first split the disputed space (``split_territories``). Then: parts over
     carcasses and background (a part is what a robot handles; the carcass is estimated); of two
@@ -182,6 +184,7 @@ def separate_colliders(objects: list[_Object], config: ExportConfig) -> tuple[li
         o.part, o.sweep = pieces, path
     sweeps = ObstacleSet([ob for o in objects for ob in o.sweep])
     carcasses: list[Obstacle] = []
+    cavities: list[Obstacle] = []
     for o in objects:  # carcasses: out of every path and of earlier carcasses
         if o.base is None:
             continue
@@ -194,7 +197,10 @@ def separate_colliders(objects: list[_Object], config: ExportConfig) -> tuple[li
         hull = hull_obstacle(np.vstack([p.vertices for p in o.base]), o.oid, "carcass") if o.base else None
         if hull is not None:
             carcasses.append(hull)
-    return sweeps.items + carcasses, stats
+        cavity = cavity_obstacle(o.base, o.oid)
+        if cavity is not None:
+            cavities.append(cavity)
+    return sweeps.items, carcasses, cavities, stats
 
 
 def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportConfig | None = None,
@@ -234,14 +240,19 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
         inner = pieces_of(moving[1], budget) if len(moving) > 1 else []
         objects.append(_Object(oid, obj, moving, front + inner, base,
                                pieces_of(base, config.max_convex_hulls) if base is not None else None, n_front=len(front)))
-    obstacles, stats = separate_colliders(objects, config)
+    sweeps, carcasses, cavities, stats = separate_colliders(objects, config)
     margin = config.collider_clearance_m
-    keep, fragments = carve_faces(bg.vertices, bg.faces, obstacles, margin, 4 * config.background_patch_min_m)
+    # triangles inside a part's path or a carcass stop colliding (the carcass stands for what was scanned
+    # there); those merely near stay (the floor under a door's swing, the frame around a front). The slabs
+    # fitted to them are cut back to the clearance from every path and cavity; a slab touching a carcass
+    # wall from outside stays (two static bodies: no engine collides them).
+    keep, fragments = carve_faces(bg.vertices, bg.faces, sweeps + carcasses, 0.0, 4 * config.background_patch_min_m)
+    obstacles = sweeps + cavities
     params = (config.background_patch_m, thick, config.background_patch_min_m, config.background_patch_flatness_m, margin,
-              obstacle_digest(obstacles))
+              config.background_slab_m, obstacle_digest(sweeps + carcasses + cavities))
     patches = cached_pieces(cache_dir, "patches", bg, params, lambda: planar_patches(
         bg, config.background_patch_m, thick, config.background_patch_min_m, config.background_patch_flatness_m, obstacles, margin,
-        faces=np.flatnonzero(keep), extra=fragments))
+        faces=np.flatnonzero(keep), extra=fragments, slab=config.background_slab_m))
     stats["background_faces_carved"] = int((~keep).sum())
     links = [
         Link(

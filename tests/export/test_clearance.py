@@ -9,6 +9,7 @@ import trimesh
 from react3d_core.data import Articulation, TriMesh
 from react3d_core.export.clearance import (
     carve_faces,
+    cavity_obstacle,
     clip_halfspace,
     face_conflicts,
     gap,
@@ -118,6 +119,8 @@ def test_patches_lie_behind_their_surface() -> None:
     (p,) = planar_patches(tm(floor), cell=2.0, min_thickness=0.01)
     assert p.vertices[:, 2].max() == pytest.approx(0.0)  # the slab's top is the floor
     assert p.vertices[:, 2].min() == pytest.approx(-0.01)
+    (p,) = planar_patches(tm(floor), cell=2.0, min_thickness=0.01, slab=0.02)
+    assert p.vertices[:, 2].max() == pytest.approx(0.0) and p.vertices[:, 2].min() == pytest.approx(-0.02)
 
 
 def test_patches_split_parallel_surfaces_and_keep_clear_of_obstacles() -> None:
@@ -149,3 +152,43 @@ def test_territory_plane_bisects_turned_fronts_and_splits_coplanar_ones() -> Non
     fb = fa + np.array([0, 0, 0.203])
     m, c = territory_plane(fa, np.array([np.sin(0.05), np.cos(0.05), 0]), fb, np.array([-np.sin(0.05), np.cos(0.05), 0]))
     assert m @ np.array([0, 0, 1.0]) == pytest.approx(1.0) and c == pytest.approx(0.5015)  # between z = 0.5 and 0.503
+
+
+def box_piece(lo, hi) -> ConvexPiece:  # noqa: ANN001
+    """An axis-aligned box piece that knows it is a box (written as a box primitive)."""
+    c = cube(lo, hi)
+    lo_, hi_ = np.asarray(lo, float), np.asarray(hi, float)
+    return ConvexPiece(c.vertices, c.faces, "patch", np.concatenate([(lo_ + hi_) / 2, np.eye(3).reshape(9), hi_ - lo_]))
+
+
+def test_cavity_is_the_walls_hull_moved_in_by_their_thickness() -> None:
+    # five 0.02 m walls of a cabinet [0, 0.5] x [0, 0.4] x [0, 0.6], open at y = 0 (the front)
+    t = 0.02
+    walls = [box_piece((0, 0, 0), (t, 0.4, 0.6)), box_piece((0.5 - t, 0, 0), (0.5, 0.4, 0.6)),
+             box_piece((t, 0, 0), (0.5 - t, 0.4, t)), box_piece((t, 0, 0.6 - t), (0.5 - t, 0.4, 0.6)),
+             box_piece((t, 0.4 - t, t), (0.5 - t, 0.4, 0.6 - t))]
+    cav = cavity_obstacle(walls, "cab")
+    assert cav is not None and cav.kind == "cavity"
+    np.testing.assert_allclose(cav.lo, [t, t, t], atol=1e-9)  # the open front is moved in too
+    np.testing.assert_allclose(cav.hi, [0.5 - t, 0.4 - t, 0.6 - t], atol=1e-9)
+    inside = cube((0.2, 0.1, 0.2), (0.3, 0.2, 0.3))
+    assert gap(inside.vertices, piece_axes(inside), cav)[0] < 0
+    outside = cube((0.6, 0.1, 0.2), (0.7, 0.2, 0.3))  # beside the cabinet: 0.6 - 0.48 from the cavity
+    assert gap(outside.vertices, piece_axes(outside), cav)[0] == pytest.approx(0.12)
+    assert cavity_obstacle([box_piece((0, 0, 0), (0.03, 0.03, 0.03))], "solid") is None  # no room inside
+    assert cavity_obstacle([], "none") is None
+
+
+def test_a_box_cut_along_its_own_axis_stays_a_box() -> None:
+    slab = box_piece((0, 0, -0.02), (1, 1, 0))
+    ob = hull_obstacle(cube((0.8, -0.5, -0.5), (1.5, 1.5, 0.5)).vertices, "o", "sweep")
+    (out,), st = keep_clear([slab], [ob], 0.005)
+    assert st.cut == 1 and out.box is not None  # still a box primitive
+    c, R, ext = out.box_frame()
+    np.testing.assert_allclose(ext, [0.795, 1, 0.02], atol=1e-9)
+    np.testing.assert_allclose(c, [0.3975, 0.5, -0.01], atol=1e-9)
+    # an oblique obstacle face: the cut is not along a box axis, the piece becomes a general hull
+    tilted = trimesh.creation.box(extents=(0.4, 3, 1)).apply_transform(trimesh.transformations.rotation_matrix(np.radians(30), (0, 0, 1)))
+    ob = hull_obstacle(np.asarray(tilted.vertices) + [1.0, 0.5, 0], "o", "sweep")
+    (out,), _ = keep_clear([slab], [ob], 0.005)
+    assert out.box is None and gap(out.vertices, piece_axes(out), ob)[0] >= 0.005 - 1e-9

@@ -146,7 +146,7 @@ def test_cell_atlas_path_loads_in_simulators(scene_dir: Path, tmp_path: Path) ->
     out = export_scene(d, formats=("urdf", "mjcf"), config=ExportConfig(xatlas_max_faces=1, texel_per_m=50, write_glb=False))
     obj = out["urdf"].parents[1] / "assets" / "background" / "visual_0" / "mesh.obj"
     text = obj.read_text()
-    assert text.count("\nv ") == 13 * 13 + 9 * 9 and " 1/" in text  # scan positions once, UVs per corner
+    assert text.count("\nv ") == 13 * 13 + 9 * 9 + 3 * 3 and " 1/" in text  # scan positions once (floor, wall, cabinet top), UVs per corner
     model = mujoco.MjModel.from_xml_path(str(out["mjcf"]))
     assert model.ntex >= 5
     cid = pb.connect(pb.DIRECT)
