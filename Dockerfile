@@ -9,6 +9,7 @@ RUN apt-get update && apt-get install -y --no-install-recommends libusb-1.0-0 li
 WORKDIR /opt/react3d
 COPY pyproject.toml README.md ./
 COPY react3d_core ./react3d_core
+COPY react3d_models ./react3d_models
 COPY tasks ./tasks
 COPY flows ./flows
 COPY deployments ./deployments

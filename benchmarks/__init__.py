@@ -1,2 +1,2 @@
-"""Benchmarks: the ``react3d bench`` runner and its scene sets (package data), plus standalone
-benchmark scripts (``python3 benchmarks/bench_*.py``) that print a table and write JSON."""
+"""Benchmark scripts (``python3 benchmarks/bench_*.py``) that print a table and write JSON; the
+``react3d bench`` runner, its scene sets and the miss-cause tracer are in ``flows/bench/``."""

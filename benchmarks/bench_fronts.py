@@ -1,14 +1,15 @@
 """Front-level score of the heuristic perception step (no segmentation, articulation or export):
 the fronts it finds against the ground-truth parts, per scene and in total.
 
-    python3 benchmarks/bench_fronts.py --scenes tuning_realistic_2 [--heuristic '{"protrusion_from_surface": true}'] \
-        [--out /tmp/fronts] [--jobs 2] [--json F]
+    python3 benchmarks/bench_fronts.py --scenes tuning_realistic_2 [--heuristic '{"handles": {"protrusion_from_surface": true}}'] \
+        [--out /tmp/fronts] [--jobs 2] [--json F] [--dump DIR]
 
-``--scenes`` is a set (benchmarks/sets/NAME.json; missing scenes are generated under ``--out``) or a glob
+``--scenes`` is a set (flows/bench/sets/NAME.json; missing scenes are generated under ``--out``) or a glob
 of scene folders. Matching: ``react3d_core.metrics.front_match`` (area IoU >= 0.5, one-to-one); a front
 with a joint counts as typed right when its joint type is the part's. Minutes per set where the full
 ``react3d bench`` takes an hour, for deciding thresholds on the tuning sets; report with the full bench.
-Prints a table and writes JSON.
+Prints a table and writes JSON. ``--dump DIR`` also writes every front found (plane, rectangle, faces,
+handles, kind, joint; exact floats) to DIR/<scene>.json, so two versions of the code can be diffed front by front.
 """
 
 from __future__ import annotations
@@ -25,15 +26,45 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 
-def score_scene(scene_dir: str, overrides: dict[str, Any]) -> dict[str, Any]:
-    """Build the heuristic on one scene folder (stride 1, as ``react3d bench``) and score its fronts."""
-    from benchmarks.miss_causes import gt_part_faces
-    from benchmarks.runner import _gt_dir
+def front_records(model: Any) -> list[dict[str, Any]]:
+    """Every front of a built ``HeuristicModel`` as JSON-exact records (floats round-trip; face lists as
+    count + SHA-256): what a refactor of the heuristic must leave unchanged."""
+    import hashlib
+
+    import numpy as np
+
+    def arr(a: Any) -> Any:
+        return None if a is None else np.asarray(a, float).tolist()
+
+    def digest(a: Any) -> Any:
+        if a is None:
+            return None
+        a = np.ascontiguousarray(a)
+        return [int(a.shape[0]), a.dtype.str, hashlib.sha256(a.tobytes()).hexdigest()]
+
+    out = []
+    for f in model.fronts:
+        j = f.articulation
+        out.append({"facet": int(f.facet), "handle_facets": [int(k) for k in f.handle_facets],
+                    "frame_facets": [int(k) for k in f.frame_facets], "center": arr(f.center), "n_out": arr(f.n_out),
+                    "u": arr(f.u), "extent_u": arr(f.extent_u), "extent_v": arr(f.extent_v), "kind": f.kind,
+                    "faces": digest(f.faces), "handle_points": digest(f.handle_points),
+                    "shadow_points": digest(f.shadow_points),
+                    "joint": None if j is None else {"type": j.joint_type, "axis": arr(j.axis), "origin": arr(j.origin),
+                                                     "lower": float(j.lower), "upper": float(j.upper)}})
+    return out
+
+
+def score_scene(scene_dir: str, overrides: dict[str, Any], dump: str | None = None) -> dict[str, Any]:
+    """Build the heuristic on one scene folder (stride 1, as ``react3d bench``) and score its fronts;
+    ``dump``: a folder to write every front to (``front_records``)."""
+    from flows.bench.miss_causes import gt_part_faces
+    from flows.bench.runner import _gt_dir
     from react3d_core.config import PipelineConfig
     from react3d_core.ground_truth.articulate3d import read_articulate3d
     from react3d_core.metrics.front_match import match_fronts
     from react3d_core.perception.heuristic import HeuristicModel
-    from react3d_core.scene_io.loaders import load_scene
+    from react3d_core.scene_io import load_scene
 
     t0 = time.perf_counter()
     d = Path(scene_dir)
@@ -47,12 +78,16 @@ def score_scene(scene_dir: str, overrides: dict[str, Any]) -> dict[str, Any]:
     s = match_fronts([faces[p.part_id] for p in gt.movable], [fr.faces for fr in model.fronts], model.mesh.face_areas)
     typed = sum(1 for i, j, _ in s.pairs if model.fronts[j].articulation is not None
                 and model.fronts[j].articulation.joint_type == gt.movable[i].articulation.joint_type)
+    if dump:
+        from react3d_core.atomic import write_json
+
+        write_json(Path(dump) / f"{d.name}.json", front_records(model))
     return {"scene": d.name, "tp": s.tp, "pred": s.n_pred, "gt": s.n_gt, "precision": s.precision, "recall": s.recall,
             "f1": s.f1, "joint_type_ok": typed, "seconds": time.perf_counter() - t0}
 
 
 def _scene_dirs(spec: str, out: Path) -> list[str]:
-    from benchmarks.runner import ensure_scene, load_spec
+    from flows.bench.runner import ensure_scene, load_spec
 
     return [str(ensure_scene(e)) for e in load_spec(spec, out)]
 
@@ -64,11 +99,12 @@ def main(argv: list[str] | None = None) -> dict[str, Any]:
     ap.add_argument("--out", default="/tmp/react3d_bench_fronts", help="where generated scenes go")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--json", dest="json_path")
+    ap.add_argument("--dump", help="folder: every front found, per scene (exact, for diffing two versions)")
     a = ap.parse_args(argv)
     overrides = json.loads(a.heuristic)
     dirs = _scene_dirs(a.scenes, Path(a.out))
     with get_context("spawn").Pool(max(1, a.jobs)) as pool:
-        rows = pool.starmap(score_scene, [(d, overrides) for d in dirs])
+        rows = pool.starmap(score_scene, [(d, overrides, a.dump) for d in dirs])
     tp, pred, gt = (sum(r[k] for r in rows) for k in ("tp", "pred", "gt"))
     total = {"tp": tp, "pred": pred, "gt": gt, "precision": tp / pred if pred else 0.0, "recall": tp / gt if gt else 0.0,
              "f1": 2 * tp / (pred + gt) if pred + gt else 0.0,

@@ -6,7 +6,7 @@ Without SCENE it measures a synthetic TSDF kitchen (960x720 photo frames, made i
 folder) and, when present, the real RedKitchen scan (640x480). Each scene is built twice in one
 process (mesh-only heuristic, then mesh + images) after a warm-up read of the frames; the added cost
 per frame is (t_image - t_mesh) / frames. ``--register`` measures the image path with the opt-in
-per-view colour registration on (``register_sigmas_px`` 12, 6, 3, 1.5). Prints a table and writes JSON.
+per-view colour registration on (``registration.sigmas_px`` 12, 6, 3, 1.5). Prints a table and writes JSON.
 """
 
 from __future__ import annotations
@@ -28,10 +28,8 @@ REGISTER_SIGMAS = (12.0, 6.0, 3.0, 1.5)
 
 def measure(scene_dir: Path, stride: int, register: bool = False) -> dict:
     from react3d_core.config import FrameSelectionConfig
+    from react3d_core.config.heuristic import HeuristicConfig
     from react3d_core.perception.heuristic import HeuristicModel
-    from react3d_core.perception.heuristic.image_fronts import ImageFrontParams
-    from react3d_core.perception.heuristic.orthophoto import OrthoParams
-    from react3d_core.perception.heuristic.view_registration import RegistrationParams
     from react3d_core.scene_io import load_scene
     from react3d_core.scene_io.images import frame_rgb
 
@@ -39,11 +37,9 @@ def measure(scene_dir: Path, stride: int, register: bool = False) -> dict:
     for f in scene.frames:  # warm the page cache: both runs read the same files
         frame_rgb(f)
     t0 = time.perf_counter()
-    mesh_only = HeuristicModel(scene, image=None)
+    mesh_only = HeuristicModel(scene, HeuristicConfig(image={"enabled": False}))
     t1 = time.perf_counter()
-    params = ImageFrontParams(ortho=OrthoParams(register=RegistrationParams(sigmas_px=REGISTER_SIGMAS))) if register \
-        else ImageFrontParams()
-    both = HeuristicModel(scene, image=params)
+    both = HeuristicModel(scene, HeuristicConfig(registration={"sigmas_px": REGISTER_SIGMAS}) if register else None)
     t2 = time.perf_counter()
     n = len(scene.frames)
     w, h = scene.frames[0].intrinsics.width, scene.frames[0].intrinsics.height

@@ -1,4 +1,4 @@
-"""Perception-model throughput: reference-style calls versus the tasks/models way of calling them.
+"""Perception-model throughput: reference-style calls versus the react3d_models way of calling them.
 
     python3 benchmarks/bench_models.py --json bench_models.json            # GPU: real architectures
     python3 benchmarks/bench_models.py --tiny --json bench_models.json     # CPU smoke run, tiny configs
@@ -35,7 +35,7 @@ def sam_spec(variant: str, tiny: bool) -> tuple[Callable[[], Any], Callable[[Any
     import torch
     from transformers import SamModel
 
-    from tasks.models.random_checkpoints import sam_config
+    from react3d_models.random_checkpoints import sam_config
 
     cfg = sam_config("tiny" if tiny else "real", variant)
     size = cfg.vision_config.image_size
@@ -55,7 +55,7 @@ def gdino_spec(tiny: bool) -> tuple[Callable[[], Any], Callable[[Any, int, Any, 
     import torch
     from transformers import GroundingDinoForObjectDetection
 
-    from tasks.models.random_checkpoints import detector_config
+    from react3d_models.random_checkpoints import detector_config
 
     cfg = detector_config("tiny" if tiny else "real")
     hw = (64, 96) if tiny else (800, 1066)
@@ -125,7 +125,7 @@ def mask_transfer(device: Any, n: int = 16, hw: tuple[int, int] = (1440, 1920), 
     import numpy as np
     import torch
 
-    from tasks.models.host_sync import masks_to_host
+    from react3d_models.host_sync import masks_to_host
 
     if device.type != "cuda":
         print("--mask-transfer needs a CUDA device: skipped")
@@ -163,7 +163,7 @@ def main(argv: list[str] | None = None) -> int:
     from rich.console import Console
     from rich.table import Table
 
-    from tasks.models.runtime import resolve_dtype
+    from react3d_models.runtime import resolve_dtype
 
     torch.manual_seed(0)
     device = torch.device("cuda" if torch.cuda.is_available() else "cpu")

@@ -177,7 +177,7 @@ def run_stage(perception: Any, frames: list[Any], cfg: Any, batch: int, workers:
 def per_call(perception: Any, frames: list[Any], batch: int, reps: int) -> dict[str, float]:
     """ms per frame of each model call, sequential, on ``reps`` batches of ``batch`` frames."""
     from react3d_core.scene_io.images import frame_rgb
-    from tasks.models.grounded_sam import QUERIES_PER_DETECTION, detect, sam_box_masks_batched, sam_image_embeddings, top_detections
+    from react3d_models.grounded_sam import QUERIES_PER_DETECTION, detect, sam_box_masks_batched, sam_image_embeddings, top_detections
 
     seg = perception.segmenter
     acc = {"read_jpeg": 0.0, "clip_tagger": 0.0, "grounding_dino": 0.0, "sam_encoder": 0.0, "sam_decoder_masks": 0.0}
@@ -210,7 +210,7 @@ def stock_models(paths: dict[str, Path], device: Any) -> tuple[Any, Any]:
     import torch
     from transformers import AutoProcessor, GroundingDinoForObjectDetection, SamModel, SamProcessor
 
-    from tasks.models.runtime import Loaded
+    from react3d_models.runtime import Loaded
 
     det = GroundingDinoForObjectDetection.from_pretrained(str(paths["detector"])).to(device).eval()
     sam = SamModel.from_pretrained(str(paths["sam"])).to(device).eval()
@@ -223,7 +223,7 @@ def stock_detect(det: Any, image: Any, box_t: float, text_t: float) -> Any:
     model's output tensors (on the GPU when the model is there)."""
     import torch
 
-    from tasks.models.grounded_sam import detections_from_outputs, detector_prompt
+    from react3d_models.grounded_sam import detections_from_outputs, detector_prompt
 
     inputs = det.processor(images=[image], text=[detector_prompt(PHRASES)], return_tensors="pt").to(det.device)
     with torch.inference_mode():
@@ -238,7 +238,7 @@ def reference(paths: dict[str, Path], frames: list[Any], n: int, device: Any, bo
     import torch
 
     from react3d_core.scene_io.images import frame_rgb
-    from tasks.models.grounded_sam import sam_box_masks, sam_image_embeddings, top_detections
+    from react3d_models.grounded_sam import sam_box_masks, sam_image_embeddings, top_detections
 
     saved = os.environ.get("TRANSFORMERS_DISABLE_TORCH_CHECK")
     os.environ["TRANSFORMERS_DISABLE_TORCH_CHECK"] = "0"
@@ -307,7 +307,7 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--frames", type=int, default=300)
     p.add_argument("--width", type=int, default=1920)
     p.add_argument("--height", type=int, default=1440)
-    p.add_argument("--batch", type=int, default=8, help="frames per perceive() call (perception.batch_size)")
+    p.add_argument("--batch", type=int, default=8, help="frames per perceive() call and per model forward (perception.batch_size, perception.models.batch_size)")
     p.add_argument("--workers", type=int, default=4, help="threads running perceive() (the flow runs 4)")
     p.add_argument("--subset", type=int, default=64, help="frames for the variants and the out-of-memory check")
     p.add_argument("--ref-frames", type=int, default=3)
@@ -325,12 +325,12 @@ def main(argv: list[str] | None = None) -> int:
     from rich.console import Console
 
     from react3d_core.config import PerceptionConfig
-    from tasks.models import make_model_perception
-    from tasks.models.random_checkpoints import save_random_checkpoints
-    from tasks.models.runtime import clear_cache
+    from react3d_models import make_model_perception
+    from react3d_models.random_checkpoints import save_random_checkpoints
+    from react3d_models.runtime import clear_cache
 
     if a.plain_mask_copy:
-        from tasks.models import grounded_sam
+        from react3d_models import grounded_sam
 
         grounded_sam.masks_to_host = lambda m: m.cpu().numpy()  # type: ignore[assignment]
     gpu = torch.cuda.is_available()
@@ -362,14 +362,14 @@ def main(argv: list[str] | None = None) -> int:
     frames = write_frames(work / "frames", a.frames, a.width, a.height)
     result["write_frames_s"] = time.perf_counter() - t0
     srv, url = chat_server()
-    cfg = PerceptionConfig(backend="models", detector_model=str(paths["detector"]), sam_model=str(paths["sam"]),
-                           tagger_model=str(paths["clip"]), tag_filter_endpoint=url, box_threshold=a.box_threshold,
-                           batch_size=a.batch, device=str(device))
+    cfg = PerceptionConfig(backend="models", batch_size=a.batch, models=dict(
+        detector_model=str(paths["detector"]), sam_model=str(paths["sam"]), tagger_model=str(paths["clip"]),
+        tag_filter_endpoint=url, box_threshold=a.box_threshold, max_detections=a.max_detections, batch_size=a.batch,
+        device=str(device)))
 
     t, perception = timed(lambda: make_model_perception(cfg))
     result["load_models_s"] = t
     save()
-    perception.segmenter.max_detections = a.max_detections
     con.print(f"[bold]models loaded in {t:.1f} s; {a.frames} frames {a.width}x{a.height}")
     sub = frames[: max(2, min(a.subset, len(frames)))]
     run_stage(perception, frames[: a.batch], cfg, a.batch, 1)  # warm-up
@@ -382,9 +382,9 @@ def main(argv: list[str] | None = None) -> int:
     else:
         variants(result, runs, perception, frames, sub, cfg, a, paths, device, gpu, save)
     result["ref_fp32_b1_forward_s_per_frame"] = reference(paths, frames, 2 * a.ref_frames, device, a.box_threshold,
-                                                          cfg.text_threshold, a.max_detections, rebuild=False)
+                                                          cfg.models.text_threshold, a.max_detections, rebuild=False)
     result["ref_fp32_b1_rebuild_s_per_frame"] = reference(paths, frames, a.ref_frames, device, a.box_threshold,
-                                                          cfg.text_threshold, a.max_detections, rebuild=True)
+                                                          cfg.models.text_threshold, a.max_detections, rebuild=True)
     ours_pf = runs["ours"]["seconds"] / runs["ours"]["frames"]
     result["speedup_vs_ref_forward"] = result["ref_fp32_b1_forward_s_per_frame"] / ours_pf
     result["speedup_vs_ref_rebuild"] = result["ref_fp32_b1_rebuild_s_per_frame"] / ours_pf

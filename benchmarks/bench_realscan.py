@@ -1,7 +1,7 @@
 """Real-scan benchmark: convert 7-Scenes RedKitchen and score it against hand-drawn front boxes.
 
     python3 benchmarks/bench_realscan.py [--scene ../shared/data/redkitchen] [--out /tmp/rk_out]
-        [--perception heuristic] [--stride N] [--json benchmarks/results/redkitchen.json]
+        [--perception heuristic] [--stride N] [--json benchmarks/results/redkitchen_stride5.json]
 
 The scan has no 3D ground truth; ``tests/data/redkitchen_fronts.json`` holds 2D boxes of its 9 clearly
 visible fronts in a few colour frames (drawn by hand). ``react3d convert`` runs as its own process (``python -m

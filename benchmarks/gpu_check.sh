@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The GPU checks in one go (issue 19): gpu-marked tests, model throughput, the mask copy, the 300-frame scene
+# The GPU checks in one go: gpu-marked tests, model throughput, the mask copy, the 300-frame scene
 # (with packed and with plain mask copies), the stage's profile.
 #   bash benchmarks/gpu_check.sh OUTDIR        # on a machine with a CUDA GPU and the project installed
 # Wheels in .whl/ (if any) are installed into /tmp/site first: for a machine without a registry.

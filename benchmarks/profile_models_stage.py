@@ -1,4 +1,4 @@
-"""Where the models backend's perception stage spends its time on a GPU (issue 19): profiler tables and variants.
+"""Where the models backend's perception stage spends its time on a GPU: profiler tables and variants.
 
     python3 benchmarks/profile_models_stage.py --out DIR            # GPU: real architectures, random weights
     python3 benchmarks/profile_models_stage.py --tiny --frames 8 --out DIR   # CPU smoke run
@@ -126,8 +126,8 @@ def main(argv: list[str] | None = None) -> int:
     import transformers
 
     from react3d_core.config import PerceptionConfig
-    from tasks.models import make_model_perception
-    from tasks.models.random_checkpoints import save_random_checkpoints
+    from react3d_models import make_model_perception
+    from react3d_models.random_checkpoints import save_random_checkpoints
 
     transformers.utils.logging.disable_progress_bar()
     gpu = torch.cuda.is_available()
@@ -148,11 +148,11 @@ def main(argv: list[str] | None = None) -> int:
         paths = save_random_checkpoints(work / "models", "tiny" if tiny else "real", "vit_h", build_device=device)
         frames = write_frames(work / "frames", max(a.frames, a.profile_frames), a.width, a.height)
         srv, url = chat_server()
-        cfg = PerceptionConfig(backend="models", detector_model=str(paths["detector"]), sam_model=str(paths["sam"]),
-                               tagger_model=str(paths["clip"]), tag_filter_endpoint=url, box_threshold=0.3,
-                               batch_size=a.batch, device=str(device))
+        cfg = PerceptionConfig(backend="models", batch_size=a.batch, models=dict(
+            detector_model=str(paths["detector"]), sam_model=str(paths["sam"]), tagger_model=str(paths["clip"]),
+            tag_filter_endpoint=url, box_threshold=0.3, max_detections=a.max_detections, batch_size=a.batch,
+            device=str(device)))
         perception = make_model_perception(cfg)
-        perception.segmenter.max_detections = a.max_detections
         fr = frames[: a.frames]
         run_stage(perception, frames[: a.batch], cfg, a.batch, 1)  # warm-up
         runs: dict[str, Any] = {}

@@ -19,7 +19,7 @@ from typing import Any
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from benchmarks.runner import run_isolated, run_one  # noqa: E402
+from flows.bench.runner import run_isolated, run_one  # noqa: E402
 from react3d_core.atomic import atomic_path, write_json  # noqa: E402
 
 

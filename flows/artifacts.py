@@ -1,10 +1,13 @@
-"""Prefect artifacts a user sees in the UI: progress, a per-scene summary, the report link, dataset tables."""
+"""Prefect artifacts: what the Prefect UI shows of a run (records on the server, not files). A scene's
+progress, its summary in markdown and the link to its ``report.html`` (written by
+``react3d_core.viewer.report``); a dataset's progress and its one-row-per-scene table. Every artifact
+is made here, and each is a no-op outside a flow run: a conversion never fails over the UI."""
 
 from __future__ import annotations
 
 import re
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -16,6 +19,28 @@ def _key(s: str) -> str:
     return re.sub(r"[^a-z0-9-]+", "-", s.lower()).strip("-")[:60] or "scene"
 
 
+def create_progress(description: str) -> Any | None:
+    """A progress artifact at 0 %, or None outside a flow run (tests of a body, plain calls)."""
+    try:
+        from prefect.artifacts import create_progress_artifact
+
+        return create_progress_artifact(0.0, description=description)
+    except Exception:  # noqa: BLE001 - outside a flow run there is nothing to update
+        return None
+
+
+def set_progress(artifact: Any | None, percent: float) -> None:
+    """Move a progress artifact of :func:`create_progress` to ``percent`` (nothing for None)."""
+    if artifact is None:
+        return
+    try:
+        from prefect.artifacts import update_progress_artifact
+
+        update_progress_artifact(artifact, percent)
+    except Exception:  # noqa: BLE001 - progress is cosmetic; never fail a conversion over it
+        pass
+
+
 class Progress:
     """A ``progress(stage, done, total)`` callback (``react3d_core.pipeline.ProgressFn``) that forwards to
     an optional hook (the CLI's bar) and updates a Prefect progress artifact for the UI.
@@ -23,7 +48,7 @@ class Progress:
     The artifact is updated when a stage completes and otherwise at most every ``min_interval_s``: each
     update is an API request, and one per part and frame batch cost a cached conversion 1.3 s."""
 
-    STAGES = ("perception", "segmentation", "articulation", "assembly", "export", "report")
+    STAGES = ("perception", "segmentation", "articulation", "assembly", "export", "physics", "report")
 
     def __init__(self, hook: Callable[[str, int, int], None] | None, min_interval_s: float = 2.0,
                  clock: Callable[[], float] = time.monotonic) -> None:
@@ -31,13 +56,7 @@ class Progress:
         self.min_interval_s, self.clock = min_interval_s, clock
         self._last = -float("inf")
         self.updates = 0
-        self._artifact = None
-        try:
-            from prefect.artifacts import create_progress_artifact
-
-            self._artifact = create_progress_artifact(0.0, description="REACT3D scene conversion")
-        except Exception:  # noqa: BLE001 - outside a flow run (tests of the body) there is nothing to update
-            self._artifact = None
+        self._artifact = create_progress("REACT3D scene conversion")
 
     def __call__(self, stage: str, done: int, total: int) -> None:
         if self.hook:
@@ -50,15 +69,10 @@ class Progress:
             self._update(stage, done, total)
 
     def _update(self, stage: str, done: int, total: int) -> None:
-        from prefect.artifacts import update_progress_artifact
-
         self.updates += 1
         idx = self.STAGES.index(stage) if stage in self.STAGES else 0
         frac = (idx + done / max(total, 1)) / len(self.STAGES)
-        try:
-            update_progress_artifact(self._artifact, min(100.0, 100.0 * frac))
-        except Exception:  # noqa: BLE001 - progress is cosmetic; never fail a conversion over it
-            pass
+        set_progress(self._artifact, min(100.0, 100.0 * frac))
 
 
 def scene_summary_markdown(scene_id: str, manifest_path: str, html: str | None, timings: dict[str, float],
@@ -98,4 +112,15 @@ def publish_scene_artifacts(scene_id: str, manifest_path: str, html: str | None,
             create_link_artifact(f"file://{Path(html).resolve()}", link_text="report.html",
                                  key=f"report-{_key(scene_id)}", description="self-contained viewer and report")
     except Exception:  # noqa: BLE001 - artifacts are for the UI; a conversion never fails over them
+        pass
+
+
+def publish_dataset_table(rows: list[dict[str, Any]], columns: Sequence[str]) -> None:
+    """The ``dataset-summary`` table artifact: one row per scene, ``columns`` of each."""
+    try:
+        from prefect.artifacts import create_table_artifact
+
+        create_table_artifact([{k: r[k] for k in columns} for r in rows], key="dataset-summary",
+                              description=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
+    except Exception:  # noqa: BLE001 - the table is for the UI; the rows are returned either way
         pass

@@ -18,14 +18,16 @@ COMMANDS: dict[str, str] = {
     "evaluate": "flows.commands.evaluate",
     "bench": "flows.commands.bench",
     "export": "flows.commands.export",
+    "check": "flows.commands.check",
     "view": "flows.commands.view",
     "cache": "flows.commands.cache",
     "server": "flows.commands.server",
 }
 
 FLOW_COMMANDS = {"convert", "demo", "convert-dataset"}
-"""Commands that run Prefect flows: they reuse the server named by PREFECT_API_URL (checked first, one-line
-error if it does not answer), or start a temporary one and say so (``tasks.prefect_env.check_server``)."""
+"""Commands that run Prefect flows: they use the server named by PREFECT_API_URL (checked first, one-line
+error if it does not answer: ``tasks.prefect_env.check_server``), or else react3d's local server, which
+the first command starts once its own checks pass and later ones reuse (``flows.local_server``)."""
 
 
 def _load(name: str):  # noqa: ANN202
@@ -64,7 +66,10 @@ def main(argv: list[str] | None = None) -> int:
         if args.command in FLOW_COMMANDS:
             from tasks.prefect_env import check_server
 
-            check_server()
+            if check_server() == "local":
+                from flows import local_server
+
+                local_server.plan()
         return int(args._run(args) or 0)
     except React3DError as exc:
         if debug:

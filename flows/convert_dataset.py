@@ -32,6 +32,7 @@ from react3d_core.errors import InputError  # noqa: E402
 from tasks import storage  # noqa: E402
 from tasks.assembly import OUTPUT_KIND  # noqa: E402
 
+from .artifacts import create_progress, publish_dataset_table, set_progress  # noqa: E402
 from .convert_scene import convert_scene  # noqa: E402
 
 
@@ -177,34 +178,13 @@ def convert_dataset(root: str, scene_ids: list[str] | None = None, glob: str | N
     scenes = check_dataset_outputs(root, scene_ids, glob, out_root)
     if deployment:
         rows = fan_out(scenes, out_root, config, deployment, scene_concurrency, max_attempts)
-        _table(rows)
+        publish_dataset_table(rows, TABLE_COLUMNS)
         return rows
     rows: list[dict[str, Any]] = []
-    progress = None
-    try:
-        from prefect.artifacts import create_progress_artifact, update_progress_artifact
-
-        progress = create_progress_artifact(0.0, description=f"{len(scenes)} scenes")
-    except Exception:  # noqa: BLE001
-        pass
+    progress = create_progress(f"{len(scenes)} scenes")
     with ThreadPoolExecutor(max_workers=max(1, scene_concurrency)) as pool:
         for row in pool.map(lambda s: _one(s, out_root, config), scenes):
             rows.append(row)
-            if progress is not None:
-                try:
-                    update_progress_artifact(progress, 100.0 * len(rows) / max(len(scenes), 1))
-                except Exception:  # noqa: BLE001
-                    pass
-    _table(rows)
+            set_progress(progress, 100.0 * len(rows) / max(len(scenes), 1))
+    publish_dataset_table(rows, TABLE_COLUMNS)
     return rows
-
-
-def _table(rows: list[dict[str, Any]]) -> None:
-    """The ``dataset-summary`` table artifact: one row per scene (a no-op outside a Prefect run)."""
-    try:
-        from prefect.artifacts import create_table_artifact
-
-        create_table_artifact([{k: r[k] for k in TABLE_COLUMNS} for r in rows], key="dataset-summary",
-                              description=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
-    except Exception:  # noqa: BLE001 - the table is for the UI; the rows are returned either way
-        pass

@@ -22,12 +22,16 @@ from prefect.task_runners import ThreadPoolTaskRunner  # noqa: E402
 
 from react3d_core.atomic import atomic_dir, check_output_dir  # noqa: E402
 from react3d_core.config import PipelineConfig  # noqa: E402
-from react3d_core.pipeline import OUTPUT_KIND, ProgressFn, StageClock, manifest_versions, output_marker  # noqa: E402
+from react3d_core.pipeline import (OUTPUT_KIND, ProgressFn, StageClock, manifest_versions, output_marker,  # noqa: E402
+                                   record_physics)
 from tasks import storage  # noqa: E402
 from tasks.articulation import articulate_part  # noqa: E402
 from tasks.assembly import assemble, export, stage_output  # noqa: E402
+from tasks.evaluation import evaluate  # noqa: E402
+from tasks.manifest import finalize  # noqa: E402
 from tasks.perception import perceive_frames  # noqa: E402
-from tasks.report import evaluate, finalize, report  # noqa: E402
+from tasks.physics import check_physics  # noqa: E402
+from tasks.report import report  # noqa: E402
 from tasks.scene import fingerprint_scene  # noqa: E402
 from tasks.segmentation import segment_scene  # noqa: E402
 
@@ -39,6 +43,17 @@ _install_server_watchdog()  # Prefect's temporary server ends with this process,
 
 def _chunks(items: list[str], n: int) -> list[list[str]]:
     return [items[i:i + n] for i in range(0, len(items), n)]
+
+
+def _physics(exported: dict[str, Any], config: dict[str, Any], manifest: str) -> None:
+    """Run the (cached) physics check and record it in the staged output; a check that cannot run is
+    reported in the manifest and never fails the conversion."""
+    try:
+        result = check_physics(exported, config)
+    except Exception as exc:  # noqa: BLE001 - reported, not raised: the scene itself is fine
+        record_physics(manifest, None, f"{type(exc).__name__}: {str(exc).strip()[:300]}")
+        return
+    record_physics(manifest, result)
 
 
 @flow(name="react3d-convert-scene", task_runner=ThreadPoolTaskRunner(max_workers=4), persist_result=False)
@@ -90,6 +105,9 @@ def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None =
             # no formats (accuracy benchmarks): publish the assembled scene without simulator files
             exp = export(asm, c, formats) if formats else asm
             staged = done(stage_output(exp, str(staging), str(out), fp["mesh_path"]))
+        if formats and cfg.physics.enabled:
+            with clock.stage("physics", 1) as done:
+                done(_physics(exp, c, staged))
         if fp["gt_dir"]:
             t = time.perf_counter()
             metrics = evaluate(staged, fp["gt_dir"], c)

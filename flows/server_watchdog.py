@@ -1,9 +1,10 @@
 """Run Prefect's temporary API server (uvicorn) so that it ends with the process that started it.
 
-Prefect 3 starts ``python -m uvicorn ...`` for an embedded run and stops it at exit; a killed
-``react3d convert`` (kill -9, OOM killer, a closed terminal) left it running, reparented to PID 1,
-~200 MB each (issue 20, item 9). :func:`install` makes Prefect start it through this module, which
-watches its parent and shuts the server down when the parent is gone.
+Flows called from Python with no server configured make Prefect 3 start ``python -m uvicorn ...`` and
+stop it at exit; a killed process (kill -9, OOM killer, a closed terminal) left it running, reparented
+to PID 1, ~200 MB each. :func:`install` makes Prefect start it through this module, which watches its
+parent and shuts the server down when the parent is gone. (``react3d`` commands use the shared local
+server of ``flows.local_server`` instead, and skip this.)
 
 Usage (by :func:`install` only): ``python -m flows.server_watchdog PARENT_PID UVICORN_ARGS...``.
 """
@@ -63,7 +64,10 @@ def install() -> bool:
     affected); False when this Prefect has no such server class."""
     from prefect.settings import get_current_settings
 
-    if get_current_settings().api.url:  # a real server: nothing temporary to watch (and no import cost)
+    from . import local_server
+
+    # a real server, or a command that will use the local one: nothing temporary to watch (and no import cost)
+    if get_current_settings().api.url or local_server.planned():
         return False
     try:
         from prefect.server.api import server as srv

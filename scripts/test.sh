@@ -1,18 +1,21 @@
 #!/usr/bin/env bash
-# One command: install (system libraries and headless Chromium included), then run the fast test suite.
+# One command: install what is missing (system libraries and headless Chromium included), then run the
+# fast test suite and print its 15 slowest steps. An apt package that could not be installed is not
+# tried again on every run: remove .tools/apt-unavailable-<name> to retry.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh test
-if ! command -v chromium >/dev/null && command -v apt-get >/dev/null; then
-  echo "[test] installing Debian chromium for the viewer tests ..."
-  SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
-  $SUDO apt-get update -qq || true
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq chromium >/dev/null || echo "[test] chromium unavailable: browser tests will be skipped"
-fi
-if ! command -v docker-compose >/dev/null && ! docker compose version >/dev/null 2>&1 && command -v apt-get >/dev/null; then
-  echo "[test] installing docker-compose (validates docker-compose.yml; no engine needed) ..."
-  SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq docker-compose >/dev/null 2>&1 || echo "[test] docker-compose unavailable: compose validation skipped"
-fi
+SUDO=""; [ "$(id -u)" = 0 ] || SUDO="sudo"
+apt_once() {  # apt_once PACKAGE WHY: install PACKAGE unless an earlier attempt found it unavailable
+  local mark=".tools/apt-unavailable-$1"
+  [ -e "$mark" ] && { echo "[test] $1 unavailable (earlier attempt; rm $mark to retry): $2"; return 0; }
+  command -v apt-get >/dev/null || return 0
+  echo "[test] installing $1 ..."
+  { $SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "$1" >/dev/null 2>&1; } \
+    || { mkdir -p .tools && : > "$mark" && echo "[test] $1 unavailable: $2"; }
+}
+command -v chromium >/dev/null || apt_once chromium "browser tests will be skipped"
+command -v docker-compose >/dev/null || docker compose version >/dev/null 2>&1 \
+  || apt_once docker-compose "compose validation skipped (it validates docker-compose.yml; no engine needed)"
 export TMPDIR="${TMPDIR:-/tmp}"
-python3 -m pytest -n 2 --dist loadfile -q "$@"
+python3 -m pytest -n 2 --dist loadfile --durations=15 -q "$@"

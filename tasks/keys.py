@@ -15,7 +15,7 @@ from typing import Any
 
 from react3d_core.pipeline import key_material
 
-KEY_VERSION = "2"  # 2: keys derived from the stage descriptors (issue #17)
+KEY_VERSION = "2"  # 2: keys derived from the stage descriptors
 
 
 def canonical(x: Any) -> Any:
@@ -37,9 +37,9 @@ def model_backend_version(config: dict[str, Any]) -> dict[str, str]:
     """The model backend's version, when the config uses it (its module imports nothing heavy)."""
     if (config.get("perception") or {}).get("backend") != "models":
         return {}
-    from tasks.models.version import STAGE_VERSION
+    from react3d_models.version import STAGE_VERSION
 
-    return {"tasks.models": STAGE_VERSION}
+    return {"react3d_models": STAGE_VERSION}
 
 
 def step_key(step: str, params: dict[str, Any], extra_versions: ExtraVersions | None = None,

@@ -27,19 +27,15 @@ _BUILD_LOCK = threading.Lock()  # batches run in threads: build a backend once, 
 
 
 def get_perception(scene: SceneInput, cfg: PerceptionConfig) -> Perception:
-    """The backend for this scene, built once per worker (models: once per worker for all scenes)."""
-    cfg_json = cfg.model_dump_json()
-    key = (cfg_json, "" if cfg.backend == "models" else str(scene.mesh_path))
+    """The backend for this scene, built once per worker by the perception factory (models, which do not
+    depend on the scene: once per worker for all scenes)."""
+    from react3d_core.perception import make_perception
+    from react3d_core.perception.factory import PLUGIN_BACKENDS
+
+    key = (cfg.model_dump_json(), "" if cfg.backend in PLUGIN_BACKENDS else str(scene.mesh_path))
     with _BUILD_LOCK:
         if key not in _BACKENDS:
-            if cfg.backend == "models":
-                from tasks.models import make_model_perception
-
-                _BACKENDS[key] = make_model_perception(cfg)
-            else:
-                from react3d_core.perception import make_perception
-
-                _BACKENDS[key] = make_perception(scene, cfg)
+            _BACKENDS[key] = make_perception(scene, cfg)
         return _BACKENDS[key]
 
 

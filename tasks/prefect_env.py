@@ -1,8 +1,9 @@
 """Quiet, robust defaults for an embedded Prefect run (set before ``import prefect``; user values win),
-and the guard that makes Prefect decode only JSON result records (:func:`guard_result_records`).
+which server a command uses (:func:`check_server`), and the guard that makes Prefect decode only JSON
+result records (:func:`guard_result_records`).
 
-Measured on 2 cores (docs/orchestration.md): the temporary SQLite server needs > 20 s to start the
-first time, prints telemetry errors on a closed network and noisy shutdown tracebacks.
+Measured on 2 cores (docs/orchestration.md): a SQLite server needs > 20 s to start the first time (a
+fresh database is migrated), prints telemetry errors on a closed network and noisy shutdown tracebacks.
 """
 
 from __future__ import annotations
@@ -34,22 +35,22 @@ def configure() -> None:
         os.environ.setdefault(k, v)
     from .storage import configure_result_storage
 
-    configure_result_storage()  # result records beside the shared store (REACT3D_STORE), issue 21
+    configure_result_storage()  # result records beside the shared store (REACT3D_STORE)
 
 
 # --- Which server a command talks to ----------------------------------------------------------------
 #
-# Without an API URL every command starts Prefect's temporary server (4-15 s on 2 cores, plus ~2.5 s of
-# importing the server modules) and stops it at exit. A server that is already running (``react3d
-# server`` or ``prefect server start``), named by ``PREFECT_API_URL`` (environment or Prefect profile),
-# is reused: runs, retries and history all land in its UI, and a command pays none of that start-up.
+# A server named by ``PREFECT_API_URL`` (environment or Prefect profile: ``react3d server``, ``prefect
+# server start``, a shared one) is used as is. Without one, react3d commands share a local server that
+# the first of them starts and that stops itself when unused (``flows.local_server``). Plain Python use
+# of the flows without a URL gets Prefect's temporary server, started and stopped with the process.
 
-TEMPORARY_NOTE = ("react3d: starting a temporary Prefect server for this command (~5-15 s); to reuse one across "
-                  "commands run `react3d server` and set PREFECT_API_URL=http://127.0.0.1:4200/api")
+TEMPORARY_NOTE = ("react3d: starting a temporary Prefect server for this process (~5-15 s); to reuse one across "
+                  "runs start `react3d server` and set PREFECT_API_URL=http://127.0.0.1:4200/api")
 
 
 def api_url() -> str | None:
-    """The Prefect API this process will use (environment or active profile); None = temporary server."""
+    """The Prefect API this process will use (environment or active profile); None = none named."""
     configure()
     from prefect.settings import get_current_settings
 
@@ -70,19 +71,18 @@ def server_reachable(url: str, timeout: float = 3.0) -> bool:
 
 def check_server() -> str:
     """Before a command runs flows: ``"running"`` when ``PREFECT_API_URL`` names a server that answers,
-    ``"temporary"`` when none is set (Prefect starts one at the first flow call; the line
-    :data:`TEMPORARY_NOTE` is printed then, by ``flows.server_watchdog``).
+    ``"local"`` when none is named (the command then uses react3d's local server: ``flows.local_server``).
 
     A URL that does not answer is a one-line :class:`~react3d_core.errors.ConfigError` instead of
     Prefect's retries and traceback minutes later."""
     url = api_url()
     if not url:
-        return "temporary"
+        return "local"
     if not server_reachable(url):
         from react3d_core.errors import ConfigError
 
         raise ConfigError(f"PREFECT_API_URL={url} does not answer: start it (`react3d server`) or unset "
-                          "PREFECT_API_URL to let this command start a temporary server")
+                          "PREFECT_API_URL to let react3d start its local server")
     return "running"
 
 

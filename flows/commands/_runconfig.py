@@ -21,6 +21,9 @@ def add_pipeline_arguments(p: argparse.ArgumentParser) -> None:
                    help="Use every n-th frame (default: keyframes by camera motion and new surface, cap 300).")
     p.add_argument("--max-frames", type=int, default=None, help="Cap on frames used (evenly subsampled).")
     p.add_argument("--formats", default=None, help="Export formats, e.g. urdf,usd,mjcf ('none': no simulator files).")
+    p.add_argument("--physics", default=None,
+                   help="Physics check after the export: engines, e.g. mujoco,pybullet,sapien, or 'none' "
+                        "(default: the config's physics.engines, MuJoCo; docs/physics.md).")
 
 
 def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
@@ -58,6 +61,18 @@ def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
     if args.formats:
         formats = [f.strip().lower() for f in args.formats.split(",") if f.strip() and f.strip().lower() != "none"]
         put(("export", "formats"), formats)
+    if args.physics:
+        engines = [e.strip().lower() for e in args.physics.split(",") if e.strip()]
+        if engines == ["none"]:
+            put(("physics", "enabled"), False)
+        else:
+            from react3d_core.config.physics import ENGINES
+
+            bad = [e for e in engines if e not in ENGINES]
+            if bad:
+                raise ConfigError(f"--physics: unknown engine(s) {', '.join(bad)}: choose from {', '.join(ENGINES)} or none")
+            put(("physics", "enabled"), True)
+            put(("physics", "engines"), engines)
     _check_formats(cfg.get("export", {}).get("formats", []) if isinstance(cfg.get("export"), dict) else [])
     from react3d_core.config import PipelineConfig
 
@@ -146,10 +161,14 @@ def run_with_progress(scene: str, out: str, cfg: dict[str, Any], title: str) -> 
     """Run the convert flow with a rich progress bar (one row per stage)."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from flows import local_server
     from tasks import prefect_env
 
     prefect_env.configure()
+    local_server.attach()  # a server that has to start does so while the flow's modules load
     import flows.convert_scene as cs
+
+    local_server.ready()
 
     with Progress(TextColumn("[bold]{task.description:<13}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
                   transient=False) as bar:

@@ -1,4 +1,4 @@
-"""``react3d bench --scenes SPEC``: benchmark a scene set (the runner is ``benchmarks.runner``)."""
+"""``react3d bench --scenes SPEC``: benchmark a scene set (the runner is ``flows.bench.runner``)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ HELP = "Benchmark a scene set: convert each scene, time it, measure peak memory,
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--scenes", required=True,
-                   help="A set file (benchmarks/sets/NAME.json, or just NAME) or a glob of scene folders.")
+                   help="A set file (flows/bench/sets/NAME.json, or just NAME) or a glob of scene folders.")
     p.add_argument("--perception", choices=("oracle", "heuristic", "models"), default="heuristic")
     p.add_argument("--no-refine", action="store_true", help="Disable axis/origin refinement (ablation).")
     p.add_argument("--json", dest="json_path", help="Write the metrics JSON here.")
@@ -28,7 +28,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from benchmarks.runner import load_spec, print_table, run_bench
+    from flows.bench.runner import load_spec, print_table, run_bench
     from react3d_core.atomic import write_json
 
     out_dir = Path(args.out)

@@ -20,7 +20,7 @@ def _roots() -> list:
 
     prefect_home = Path(os.environ.get("PREFECT_HOME", Path.home() / ".prefect"))
     storage = Path(os.environ.get("PREFECT_LOCAL_STORAGE_PATH", prefect_home / "storage"))
-    # collisions/ and reports/: convex decompositions and report pieces cached by content (issue 18)
+    # collisions/ and reports/: convex decompositions and report pieces cached by content
     return [storage, cache_root() / "objects", cache_root() / "scenes", cache_root() / "quarantine",
             cache_root() / "collisions", cache_root() / "reports"]
 

@@ -40,6 +40,9 @@ def run(args: argparse.Namespace) -> int:
 
     cfg = pipeline_overrides(args)
     check_dataset_outputs(args.root, args.scenes, args.glob, args.out)  # before any scene runs
+    from flows import local_server
+
+    local_server.ready()
     from tasks import storage
 
     storage.ensure_result_block()  # REACT3D_STORE=s3://...: result records beside the store (no-op otherwise)

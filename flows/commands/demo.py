@@ -32,6 +32,9 @@ def run(args: argparse.Namespace) -> int:
     if not (scene / "synth_meta.json").exists():
         check_output_dir(scene, kind="synth")  # a folder of the user's named demo_out/scene is never replaced
     check_output_dir(out / "result", (scene,), kind="scene")
+    from flows import local_server
+
+    local_server.attach()  # a server that has to start does so while the demo scene is made
     if not (scene / "synth_meta.json").exists():
         with console.status("generating the demo scene (synthetic kitchen with ground truth)"):
             demo_scene(scene)

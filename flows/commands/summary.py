@@ -32,7 +32,25 @@ def print_summary(console: Console, manifest_path: str, metrics: dict | None = N
             mt.add_row(tau, f(r["precision"]), f(r["recall"]), f(r["f1"]), f(r["joint_acc"]), f(r["oe"]), f(r["md"]), f(r["mod"]))
         console.print(mt)
     root = Path(manifest_path).parent
+    if m.physics:
+        console.print(physics_line(m.physics) + f"  (details: {root / m.physics.get('file', 'physics_check.json')}, "
+                      f"`react3d check {root}` for all engines)")
     for name, rel in sorted(m.exports.items()):
         console.print(f"{name}: {root / rel}")
     if (root / "report.html").exists():
         console.print(f"[bold]report:[/bold] {root / 'report.html'}  (open in a browser, or `react3d view {root}`)")
+
+
+def physics_line(summary: dict) -> str:
+    """One line from the manifest's ``physics`` summary: per engine joints passing and probes."""
+    if summary.get("error"):
+        return f"[yellow]physics check could not run[/]: {summary['error']}"
+    parts = []
+    for engine, e in summary.get("engines", {}).items():
+        if e.get("status") != "ok":
+            parts.append(f"{engine} {e.get('status')}")
+            continue
+        parts.append(f"{engine} {e['passed']}/{e['joints']} joints pass, cavities {e['cavities_free']}/{e['cavities']} free, "
+                     f"fronts {e['fronts_blocked']}/{e['fronts']} blocked")
+    verdict = "[green]pass[/]" if summary.get("passed") else "[red]FAIL[/]"
+    return f"physics check {verdict}: " + "; ".join(parts)

@@ -20,9 +20,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", required=True, help="Output scene folder (replaced atomically).")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--source", default="procedural", choices=["procedural", "scene-synthesizer", "urdf"])
-    p.add_argument("--kind", default=None, choices=["kitchen", "wardrobe", "dresser", "room_door", "mixed", "sliding", "large_kitchen"],
+    p.add_argument("--kind", default=None, choices=["kitchen", "wardrobe", "dresser", "room_door", "mixed", "sliding", "large_kitchen",
+                                                   "furniture", "appliances", "glass", "dark"],
                    help="Procedural room type (default: chosen by seed; only when asked: sliding = sliding-door sideboard "
-                        "and wardrobe, large_kitchen = an L of two full walls, 32-52 parts).")
+                        "and wardrobe, large_kitchen = an L of two full walls, 32-52 parts; free-standing pieces against walls "
+                        "and free in the room beside clutter: furniture = desks, nightstands, chests, cabinets, wardrobes, "
+                        "sideboards; appliances = fridge, freezer, dishwasher, cooker, microwave, washing machine; glass = "
+                        "glass-panel doors; dark = black and dark-wood fronts).")
     p.add_argument("--frames", type=int, default=60, help="Number of RGB-D frames to render.")
     p.add_argument("--urdf", default=None, help="Articulated URDF for --source urdf.")
     p.add_argument("--up", default="z", choices=["z", "y", "x", "-z", "-y", "-x"],
@@ -38,6 +42,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="RGB renderer: photo (materials, highlights, light falloff, exposure, blur) or plain flat shading.")
     p.add_argument("--misregister", type=_pixel_shift, default=(0.0, 0.0), metavar="DX,DY",
                    help="Shift colour against depth by DX,DY pixels of the RGB image, like a Kinect (photo only).")
+    p.add_argument("--depth-dropout", default="none", choices=["none", "dark"],
+                   help="dark: no depth on dark surfaces (and at grazing angles, and near the mirror direction of glossy ones), "
+                        "like ToF / structured-light sensors, in the depth frames and the laser / TSDF mesh made from them.")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -65,7 +72,8 @@ def run(args: argparse.Namespace) -> int:
     with console.status(f"rendering {args.frames} frames ({args.source}, seed {args.seed})"):
         out = generate_scene(args.out, source=args.source, seed=args.seed, n_frames=args.frames,
                              urdf_path=args.urdf, kind=args.kind, edge=args.edge, mesh=args.mesh,
-                             realism=args.realism, misregister=args.misregister, up=args.up, scale=args.scale)
+                             realism=args.realism, misregister=args.misregister, up=args.up, scale=args.scale,
+                             depth_dropout=args.depth_dropout)
     # deterministic (hidden files stay out of scan fingerprints): lets a later synth replace this folder
     (Path(out) / OUTPUT_MARKER).write_text(json.dumps({"react3d": __version__, "kind": "synth"}))
     meta = json.loads((Path(out) / "synth_meta.json").read_text())

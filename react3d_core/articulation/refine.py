@@ -3,7 +3,7 @@
 With the part's OBB sides s1 >= s2 >= s3 along u1, u2, u3 and n the front normal (u1 x u2, oriented
 into the cavity):
 - prismatic: a' = sign(<a, n>) n, origin kept;
-- prismatic the predictor calls *sliding* (a sliding door moves in its front plane; issue 16): the
+- prismatic the predictor calls *sliding* (a sliding door moves in its front plane): the
   paper's rule would pull it straight out of the front, 90 deg off. Instead, like the revolute rule,
   l = argmax_{v in {u1, u2}} |<a, v>| and a' = sign(<a, l>) l (on a vertical front with a horizontal
   predicted motion: the front's horizontal in-plane edge), origin kept;

@@ -2,7 +2,7 @@
 
 The minimal-volume box of a door that fusion segmented a few centimetres too wide at one corner, or of a
 near-square door, is rotated 3-9 degrees in the front plane; the refinement then snaps the hinge axis
-onto that rotated edge (the large kitchens' ``obb_tilt`` joint errors, issue 16). Cabinet fronts in a
+onto that rotated edge (the large kitchens' ``obb_tilt`` joint errors). Cabinet fronts in a
 gravity-aligned scan (z up) are upright, so the upright box wins unless the minimal one is smaller by
 more than ``tolerance`` of its volume.
 """

@@ -9,7 +9,7 @@
 - d_mesh: where the ray leaves the scan's bounding box;
 - d_body: the furniture's own depth, for when nothing is seen behind it (a free-standing chest whose back
   no camera saw: d_hit then reaches the room wall 2 m away and a drawer got 1.18 m of travel in a
-  0.37 m chest, issue 16; a wall cabinet whose wall no camera saw behind it). Rays cast straight up
+  0.37 m chest; a wall cabinet whose wall no camera saw behind it). Rays cast straight up
   from points ever deeper behind the front hit the carcass top or worktop at about the same distance
   while they are inside the furniture (down to a wall cabinet's bottom board when nothing is above);
   the first depth where the hit jumps by ``body_jump_m`` (or vanishes) is past its back.

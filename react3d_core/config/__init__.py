@@ -24,7 +24,9 @@ from .export import ExportConfig
 from .fusion import ClipConfig, FusionConfig, TopKConfig
 from .heuristic import FrontRulesConfig, HeuristicConfig
 from .metrics import EvaluationConfig
+from .models import ModelsConfig
 from .perception import OracleNoiseConfig, PerceptionConfig
+from .physics import PhysicsConfig
 from .scene_io import FrameSelectionConfig
 
 
@@ -42,6 +44,7 @@ class PipelineConfig(StageConfig):
     dedup: DedupConfig = Field(default_factory=DedupConfig, description="Duplicate part removal.")
     assembly: AssemblyConfig = Field(default_factory=AssemblyConfig, description="Carving the background.")
     export: ExportConfig = Field(default_factory=ExportConfig, description="What the exporters write.")
+    physics: PhysicsConfig = Field(default_factory=PhysicsConfig, description="The physics check run after the export.")
     evaluation: EvaluationConfig = Field(default_factory=EvaluationConfig, description="Evaluation protocol thresholds.")
 
     def with_overrides(self, overrides: dict) -> "PipelineConfig":
@@ -51,7 +54,7 @@ class PipelineConfig(StageConfig):
         try:
             return PipelineConfig.model_validate(data)
         except ValidationError as exc:
-            raise ConfigError(f"invalid config override: {exc}") from None
+            raise ConfigError(f"invalid config override: {validation_summary(exc)}") from None
 
     @classmethod
     def from_file(cls, path: str | Path) -> "PipelineConfig":
@@ -66,7 +69,13 @@ class PipelineConfig(StageConfig):
         try:
             return cls.model_validate(data)
         except ValidationError as exc:
-            raise ConfigError(f"{path}: invalid config: {exc}") from None
+            raise ConfigError(f"{path}: invalid config: {validation_summary(exc)}") from None
+
+
+def validation_summary(exc: ValidationError) -> str:
+    """Every problem of a validation error on one line, as ``section.field: what is wrong`` (the CLI shows one
+    line; pydantic's own text spreads each problem over three and ends in a URL). Inputs are not echoed."""
+    return "; ".join(f"{'.'.join(str(p) for p in e['loc']) or 'config'}: {e['msg']}" for e in exc.errors())
 
 
 def _deep_update(base: dict, upd: dict) -> None:
@@ -90,8 +99,10 @@ __all__ = [
     "FusionConfig",
     "HeuristicConfig",
     "LimitConfig",
+    "ModelsConfig",
     "OracleNoiseConfig",
     "PerceptionConfig",
+    "PhysicsConfig",
     "PipelineConfig",
     "StageConfig",
     "TopKConfig",

@@ -29,7 +29,7 @@ class ExportConfig(StageConfig):
         2000, ge=1,
         description="Meshes up to this many faces get xatlas charts (fewer seams); larger ones the per-triangle cell atlas "
         "(exact at vertices, 3 UVs per face). Was 20000: xatlas took 1.3 s per 10k-face scanned part unloaded and 6-37 s "
-        "under load, the cell atlas 0.01-0.06 s for the same parts with a same-sized texture (issue 18); xatlas crashed at 80k.",
+        "under load, the cell atlas 0.01-0.06 s for the same parts with a same-sized texture; xatlas crashed at 80k.",
     )
     min_collision_thickness: float = Field(0.005, gt=0, description="Convex pieces thinner than this (m) become boxes this thick (flat scans have no volume).")
     background_patch_m: float = Field(0.5, gt=0, description="MJCF/URDF background collision: grid cell (m) of the planar convex patches.")

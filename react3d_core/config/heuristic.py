@@ -1,8 +1,40 @@
-"""The weight-free heuristic perception backend: front rules on the scan mesh, the image path, sliding doors."""
+"""The weight-free heuristic perception backend: front rules on the scan mesh, the image path, sliding doors.
 
-from pydantic import Field
+One section per part of the heuristic, named after what reads it (``perception.heuristic.ortho`` is read by
+perception/heuristic/orthophoto.py); the code takes the section itself, so each threshold is declared here
+once, with its description. Renamed keys of the earlier flat layout are rejected with their new name
+(``RENAMED``).
+"""
+
+from typing import Any
+
+from pydantic import Field, model_validator
 
 from ._base import StageConfig
+
+
+class FacetConfig(StageConfig):
+    """Planar facets of the scan mesh (perception/heuristic/facets.py)."""
+
+    weld_m: float = Field(0.001, gt=0, description="Vertices closer than this (m) are merged before faces are joined.")
+    max_angle_deg: float = Field(12.0, ge=0, le=180, description="Faces sharing an edge join when their normals differ by at most this (deg).")
+
+
+class ProbeConfig(StageConfig):
+    """Which facets the cameras see (perception/heuristic/backend.py): a few frames rendered small."""
+
+    frames: int = Field(24, ge=1, description="Frames (evenly spread) rendered to find which facets the cameras see.")
+    downscale: int = Field(4, ge=1, description="... each at the colour size divided by this (4: quarter size).")
+    view_px: int = Field(4, ge=1, description="A facet counts as seen in a probe view with at least this many pixels ...")
+    min_views: int = Field(2, ge=1, description="... and is visible when seen in this many probe views ...")
+    min_px: int = Field(40, ge=0, description="... with at least this many pixels over all probe views.")
+
+
+class RenderConfig(StageConfig):
+    """Per-frame front renders that the five perception calls read (perception/heuristic/backend.py)."""
+
+    scale: float = Field(0.5, gt=0, le=1, description="Fronts are rendered at this fraction of the colour size (upsampled).")
+    min_mask_px: int = Field(150, ge=0, description="A front yields a mask in a frame when it covers at least this many pixels there.")
 
 
 class FrontRulesConfig(StageConfig):
@@ -15,106 +47,383 @@ class FrontRulesConfig(StageConfig):
     max_h: float = Field(2.3, gt=0, description="Tallest front (m).")
     max_tilt: float = Field(0.25, ge=0, le=1, description="A front is vertical: |n_z| of its normal at most this (also bounds the image path's planes).")
     min_fill: float = Field(0.8, ge=0, le=1, description="A front's facet fills at least this share of its bounding rectangle.")
+    ring_min_fill: float = Field(0.15, ge=0, le=1, description="A door-sized facet filling less than min_fill but at least this share of its rectangle is a ring: the frame of a frame-and-panel front whose panel is too small to be a front itself.")
     handle_max_area: float = Field(0.03, gt=0, description="Largest handle facet (m^2); also the largest rim/bevel facet added to a front.")
     handle_depth: tuple[float, float] = Field((0.002, 0.09), description="Handle facets stand this far in front of the front's plane (min, max; m).")
+    handle_min_cos: float = Field(-0.3, ge=-1, le=1, description="A handle facet's normal has at least this cosine with the front's normal (a facet facing back at the front is another object's).")
+    rect_slack: float = Field(0.005, ge=0, description="Rectangle tests allow this much (m): a handle's centre lies this far inside its front, a frame piece (or a ring's panel) within the rectangle grown by it, and a frame piece borders a side when it reaches this far past the edge.")
+    parallel_cos: float = Field(0.97, ge=0, le=1, description="Two facets or fronts face the same way when the cosine between their normals is at least this (frame pieces, covering and neighbouring fronts, a mesh front and the plane it is judged on).")
+    coplanar_offset: float = Field(0.03, ge=0, description="Parallel fronts whose planes are at most this far apart (m) are coplanar (neighbours, fronts of one row).")
+    neighbour_align: float = Field(0.05, ge=0, description="Neighbours side by side share top and bottom edges, stacked ones left and right edges, within this (m).")
+    cover_depth: tuple[float, float] = Field((0.001, 0.08), description="A candidate covers another's facet when it stands this far in front of it (min, max; m): the other is a carcass face seen through the gaps once more than half of it is covered.")
     drawer_max_h: float = Field(0.45, gt=0, description="Drawers are at most this tall (m): deep drawers reach ~0.45 m, oven/dishwasher doors are >= 0.5 m.")
+    drawer_travel: float = Field(0.3, gt=0, description="A drawer's guessed travel (m): the upper limit of its prismatic joint.")
     flap_min_top: float = Field(1.2, ge=0, description="A top-hinged flap lifts upwards: its top is above this height (m, z up from the floor), above a worktop.")
+    flap_max_deg: float = Field(90.0, gt=0, description="A flap's or drop door's guessed opening (deg).")
+    door_max_deg: float = Field(100.0, gt=0, description="A side-hinged door's guessed opening (deg).")
     neighbour_gap: float = Field(0.03, ge=0, description="Coplanar fronts closer than this (m) are neighbours (door pairs, drawer stacks).")
+    row_overlap: float = Field(0.01, ge=0, description="Fronts in a row (doors_in_rows) may overlap side by side by this much (m) ...")
+    row_min_height_share: float = Field(0.7, ge=0, le=1, description="... and share at least this part of the smaller one's height.")
+    row_door_min_h: float = Field(0.5, ge=0, description="A front with a horizontal bar at least this tall (m) beside a drop-door guess makes a row of cabinet doors, not an oven.")
     frame_max_width: float = Field(0.2, ge=0, description="Widest stile/rail of a frame-and-panel front (m).")
+    frame_max_gap: float = Field(0.015, ge=0, description="A frame piece lies at most this far (m) from the panel it frames.")
+    frame_claim_margin: float = Field(0.003, ge=0, description="A frame piece two panels claim goes to the one it lies closer to by more than this (m); to neither on a tie (a face-frame rail between two doors).")
+    frame_min_sides: int = Field(3, ge=1, le=4, description="A frame borders at least this many sides of its panel (a single rail beside a front is the carcass).")
+    frame_panel_max_fill: float = Field(0.85, ge=0, le=1, description="A panel filling more than this share of the frame-and-panel rectangle is a plain front with slivers around it: nothing is absorbed.")
     frame_depth: tuple[float, float] = Field((0.001, 0.03), description="Frame pieces stand this far proud of a recessed panel (min, max; m) ...")
     raised_depth: tuple[float, float] = Field((-0.016, -0.003), description="... or a raised panel stands this far proud of them (min, max; m, negative: frame behind the panel).")
     rim_depth: float = Field(0.03, ge=0, description="A front's edge/bevel facets reach this far behind its plane (m) ...")
+    rim_front: float = Field(0.01, ge=0, description="... at most this far in front of it (m) ...")
     rim_margin: float = Field(0.02, ge=0, description="... and this far outside its rectangle (chamfered edges; m).")
+
+
+class FloorConfig(StageConfig):
+    """The floor's height, for the rules that measure from it (image fronts, room doors, drawers in reach)."""
+
+    min_area: float = Field(0.5, ge=0, description="The floor is the lowest band of upward-facing mesh holding at least this area (m^2), at its area-weighted median height; no such band: no floor rule in the image path, the mesh's lowest point elsewhere.")
+    band: float = Field(0.02, gt=0, description="Height of that band (m).")
+    min_up: float = Field(0.9, ge=0, le=1, description="Upward-facing: the face normal's z is above this.")
+
+
+class ReachConfig(StageConfig):
+    """Drawers are within reach (perception/heuristic/reach.py)."""
+
+    drawer_max_top: float = Field(1.7, ge=0, description="A drawer's top edge is at most this high above the floor (m): nothing slides out above eye level; a drawer-typed strip higher up is dropped; 0: no limit.")
+
+
+class SplashbackConfig(StageConfig):
+    """Fronts standing on a worktop flush with the wall behind it are splash-back (perception/heuristic/splashback.py)."""
+
+    enabled: bool = Field(True, description="Drop fronts standing on a worktop flush with the wall behind it (splash-back: tiles, sockets).")
+    min_z: float = Field(0.5, ge=0, description="The worktop under the front's bottom edge is above this height (m).")
+    band: float = Field(0.08, ge=0, description="The worktop is this close to the front's bottom edge in height (m).")
+    reach: tuple[float, float] = Field((0.03, 0.33), description="The strip in front of the front examined for a worktop (m in front, from/to).")
+    cover: float = Field(0.2, ge=0, le=1, description="Share of that strip the worktop must cover.")
+    min_up: float = Field(0.7, ge=0, le=1, description="Worktop faces: the normal's z is above this (a scanned worktop is noisy and cluttered: its faces tilt).")
+
+
+class RoomWallConfig(StageConfig):
+    """On the room's outer walls only room doors open (perception/heuristic/room_walls.py)."""
+
+    enabled: bool = Field(True, description="On the room's outer walls (planes with no scan surface behind them) keep only fronts shaped like room doors, typed as side-hinged doors.")
+    behind_share: float = Field(0.005, ge=0, le=1, description="Outer wall: less than this share of the scan's surface area lies behind the front's plane ...")
+    depth: float = Field(0.1, ge=0, description="... more than this far (m) ...")
+    min_area: float = Field(1.0, ge=0, description="... and the plane holds at least this much other surface (m^2) outside every front (a lone cabinet scanned from the front has no wall).")
+    plane_tol: float = Field(0.03, ge=0, description="Surface in the front's plane: faces within this of it (m) ...")
+    plane_min_cos: float = Field(0.9, ge=0, le=1, description="... facing the same way (cosine between the normals above this).")
+    door_min_h: float = Field(1.8, gt=0, description="Room door on an outer wall: at least this tall (m) ...")
+    door_w: tuple[float, float] = Field((0.6, 1.3), description="... this wide (min, max; m) ...")
+    door_floor_gap: float = Field(0.05, ge=0, description="... and its bottom edge this close to the floor (m).")
+
+
+class SlidingConfig(StageConfig):
+    """Sliding doors: two fronts on two tracks (perception/heuristic/sliding.py)."""
+
+    track_offset: tuple[float, float] = Field((0.008, 0.06), description="Plane offset between two side-by-side fronts on two tracks (m).")
+    max_overlap: float = Field(0.12, ge=0, description="The two fronts' outlines overlap by at most this (m) ...")
+    max_gap: float = Field(0.02, ge=0, description="... or leave at most this gap between them (m).")
+    min_height_overlap: float = Field(0.9, ge=0, le=1, description="Share of the smaller height the two fronts share.")
+    min_parallel: float = Field(0.97, ge=0, le=1, description="|cos| between the two fronts' normals at least this.")
+    min_travel: float = Field(0.05, gt=0, description="A sliding door's travel (its width less the overlap) is at least this (m).")
+
+
+class ImageConfig(StageConfig):
+    """Fronts found in the colour frames (perception/heuristic/image_fronts.py): cells of the plane
+    orthophotos become fronts."""
+
+    enabled: bool = Field(True, description="Also find fronts in the colour frames (real scans have no seams in the mesh).")
+    texture_factor: float = Field(3.0, ge=0, description="Handle/seam thresholds rise to this many times the plane's median response (textured planes).")
+    face_depth: tuple[float, float] = Field((-0.02, 0.07), description="Faces this far behind/in front of the plane are taken into a front (m).")
+    coverage_close: float = Field(0.02, ge=0, description="The plane's coverage (its faces' centroids on the orthophoto grid) is closed over this (m).")
+    outline_fill_px: int = Field(20, ge=0, description="Holes and notches up to this many orthophoto px wide are inside a plane's outline (handle shadows).")
+    min_faces: int = Field(4, ge=1, description="An image front holds at least this many mesh faces.")
+    mesh_share: float = Field(0.3, ge=0, le=1, description="An image front lying on a mesh front's faces by more than this share of its faces is left to the mesh front (which stands unless it holds two image fronts with handles).")
+    plain_floor_gap: float = Field(0.03, ge=0, description="A handle-less front whose bottom edge is this close to the floor (m) is a piece of wall (base units stand on a plinth; room doors have handles); 0: no floor rule.")
+    veto_plane_offset: float = Field(0.08, ge=0, description="A mesh front is judged on the orthophoto of a parallel plane at most this far from it (m) ...")
+    veto_min_px: int = Field(5, ge=1, description="... when its rectangle there is at least this many px both ways ...")
+    veto_min_seen: float = Field(0.3, ge=0, le=1, description="... and this share of it is seen; it is clutter (a tiled wall with a socket 'handle') when more than clutter.max_share of its pixels are off their background by handles.contrast.")
+
+
+class PlanesConfig(StageConfig):
+    """Large vertical planes of the mesh for the image path (perception/heuristic/planes.py)."""
+
+    offset_tol: float = Field(0.025, ge=0, description="Faces this close to a vertical plane belong to it (m).")
+    angle_tol_deg: float = Field(12.0, ge=0, description="Faces whose normal is within this of a plane's belong to it (deg).")
+    direction_smooth_bins: int = Field(5, ge=1, description="The normals' direction histogram (1-degree bins) is smoothed over this many bins.")
+    direction_min_sep_bins: int = Field(6, ge=1, description="Direction peaks are at least this many 1-degree bins apart.")
+    direction_peak_div: float = Field(5.0, gt=0, description="A direction peak holds at least min_area divided by this (m^2 per bin, smoothed).")
+    offset_bin: float = Field(0.005, gt=0, description="Bin of the plane-offset histogram along a direction (m).")
+    offset_peak_div: float = Field(10.0, gt=0, description="An offset peak holds at least min_area divided by this (m^2 per bin, smoothed over offset_tol).")
+    refit_deg: float = Field(3.0, ge=0, description="A plane at least refit_min_extent wide takes, within this of its normals' mean direction, the direction along which its faces' positions are sharpest (a curved appliance door skews the normals; deg, 0: off).")
+    refit_min_gain: float = Field(1.4, ge=1, description="... only when the offsets are at least this many times sharper (integral of the squared density) than along the normals' direction ...")
+    refit_keep_share: float = Field(0.9, ge=0, le=1, description="... and the refitted plane keeps at least this share of the area it had (turned onto another surface, it does not).")
+    refit_min_extent: float = Field(1.0, ge=0, description="Refit only planes with an unbroken stretch at least this long (m) ...")
+    refit_run_step: float = Field(0.04, gt=0, description="... unbroken on a grid of this step (m).")
+    refit_step_deg: float = Field(0.1, gt=0, description="Directions tried by the refit are this far apart (deg).")
+    refit_bin: float = Field(0.002, gt=0, description="The refit's offset density: bins of this size (m) ...")
+    refit_sigma: float = Field(0.003, gt=0, description="... smoothed by a Gaussian of this sigma (m).")
+    min_area: float = Field(0.08, ge=0, description="Smallest vertical plane photographed (m^2; at least fronts.min_w x fronts.min_h).")
+    cell: float = Field(0.04, gt=0, description="Pieces of one plane farther apart than this are separate planes (m).")
+    min_fragment_area: float = Field(0.03, ge=0, description="Fragments of a plane's coverage smaller than this are not part of it (m^2).")
+
+
+class OrthoConfig(StageConfig):
+    """Fused orthophotos of the planes (perception/heuristic/orthophoto.py)."""
+
+    resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
+    max_side_px: int = Field(1200, ge=1, description="Orthophotos of very large planes get a coarser grid, at most this many px a side.")
+    max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
+    min_cos: float = Field(0.3, ge=0, le=1, description="Views more grazing than this cos to the plane are not used.")
+    render_scale: float = Field(0.5, gt=0, le=1, description="Face-id buffer size relative to the colour image.")
+    erode_px: int = Field(3, ge=0, description="Depth-buffer pixels kept this far from depth jumps (occluder outlines).")
+    edge_jump: float = Field(0.05, gt=0, description="A depth jump between neighbouring pixels marking an outline (m).")
+    depth_tol: float = Field(0.03, ge=0, description="A plane point is seen when the scan is within this (m) ...")
+    depth_tol_rel: float = Field(0.01, ge=0, description="... plus this share of its distance from the camera.")
+    min_view_px: int = Field(50, ge=1, description="A view is fused into a plane's orthophoto when it sees at least this many of its grid pixels.")
+    margin: float = Field(0.02, ge=0, description="Grid margin around a plane's extent (m).")
+
+
+class CalibrationConfig(StageConfig):
+    """Self-calibration of the colour intrinsics against the mesh (perception/heuristic/orthophoto.py)."""
+
+    enabled: bool = Field(True, description="Self-calibrate colour focal scale / principal point against the mesh (unregistered RGB-D).")
+    scale_range: tuple[float, float] = Field((0.84, 1.12), description="Focal scales searched ...")
+    scale_steps: int = Field(15, ge=2, description="... in this many steps (coarse pass).")
+    shift_range_px: float = Field(16.0, ge=0, description="Principal-point shifts searched (px at 640 px width) ...")
+    shift_steps: int = Field(5, ge=2, description="... in this many steps each way (coarse pass).")
+    fine_scales: tuple[float, ...] = Field((-0.02, -0.01, 0.01, 0.02), description="Fine pass: focal-scale changes tried around the best.")
+    fine_shift_px: float = Field(3.0, ge=0, description="Fine pass: shifts of this much (px at 640 px width) tried each way around the best.")
+    planes: int = Field(2, ge=1, description="Calibrated on this many planes, those seen most ...")
+    max_views: int = Field(12, ge=1, description="... each on its views seeing most of it, at most this many ...")
+    min_views: int = Field(3, ge=2, description="... at least this many; disagreement on grid pixels seen this many times ...")
+    min_px: int = Field(100, ge=1, description="... at least this many of them (else the plane says nothing).")
+    min_gain: float = Field(0.2, ge=0, le=1, description="Used only when it cuts the disagreement by this fraction.")
+
+
+class RegistrationConfig(StageConfig):
+    """Per-view colour registration, opt-in (perception/heuristic/view_registration.py)."""
+
+    sigmas_px: tuple[float, ...] = Field((), description="Image blur per coarse-to-fine level (px at 640 px width), e.g. [12, 6, 3, 1.5]; () = off. For RGB-D whose colour is not synchronised with depth (docs/perception.md: what it gains and costs).")
+    prior_scale: float = Field(0.08, gt=0, description="Prior std of a view's focal scale and aspect around the scene calibration.")
+    prior_shift_px: float = Field(30.0, gt=0, description="Prior std of a view's shift (px at 640 px width).")
+    rounds: int = Field(2, ge=1, description="Per level: re-fuse the median this many times, each followed by Gauss-Newton steps per view ...")
+    iters: int = Field(3, ge=1, description="... at most this many.")
+    min_views: int = Field(3, ge=1, description="A grid pixel takes part when this many views see it.")
+    min_points: int = Field(2000, ge=1, description="A view with fewer such pixels keeps the scene calibration (8 mm grid: ~0.13 m^2).")
+    band: float = Field(2.0, ge=0, description="Signal: log brightness blurred at sigma less blurred at band x sigma (0: less the plane mean).")
+    reach: float = Field(2.0, ge=0, description="Points nearer than reach x (band or 1) x sigma to a depth jump are left out.")
+    min_gain: float = Field(0.1, ge=0, le=1, description="A view keeps its correction when it cuts its disagreement by this fraction.")
+    max_scale_step: float = Field(0.02, gt=0, description="A Gauss-Newton step changes a view's focal scale by at most this (its shift by at most sigma).")
+    converged_shift_px: float = Field(0.05, ge=0, description="Steps stop once the shift moves less than this (px at 640 px width) ...")
+    converged_scale: float = Field(1e-4, ge=0, description="... and the focal scale less than this.")
+
+
+class SeamConfig(StageConfig):
+    """Seams that cut a plane's orthophoto into cells (perception/heuristic/front_cells.py)."""
+
+    contrast: float = Field(0.01, ge=0, description="A seam pixel is this much darker than both sides (fraction of the plane's mean).")
+    width_px: int = Field(3, ge=1, description="A seam pixel is darker than both neighbours 1 to this many px away; an unseen gap with seen pixels this close on both sides is a seam too.")
+    smooth_px: int = Field(9, ge=1, description="Seam maps are smoothed along the seam direction over this many px.")
+    span: float = Field(0.35, ge=0, le=1, description="A seam covers this fraction of the cell it splits ...")
+    span_chunks: int = Field(3, ge=1, description="... and at least half of it in each of this many equal pieces of its length.")
+    prominence: float = Field(0.3, ge=0, le=1, description="... and this much more than the lines around it (vertical seams).")
+    prominence_h: float = Field(0.5, ge=0, le=1, description="The same for horizontal seams (reflections of table/shelf edges are horizontal).")
+    dip_z: float = Field(15.0, ge=0, description="A straight seam: the line's median brightness dips this many noise units below the lines beside it (found through wood grain).")
+    min_line_cover: float = Field(0.3, ge=0, le=1, description="Straight seams and colour steps: lines less covered than this share of the best-covered line score 0.")
+    noise_floor: float = Field(0.001, gt=0, description="Noise units of straight seams and colour steps are at least this (brightness / colour distance).")
+    step_contrast: float = Field(0.25, ge=0, description="A colour step along a whole line (a door leaf in a pale wall) cuts when its colour distance is at least this ...")
+    step_z: float = Field(15.0, ge=0, description="... and this many noise units of the cell's steps.")
+    step_over_dip: bool = Field(True, description="A colour step along the whole cell that is stronger than the best dark line is the cut (a shaker frame casts a dark line inside its own edge).")
+    between_z: float = Field(3.0, ge=0, description="Between two handles the cut is a straight seam of at least this many noise units ...")
+    between_span: float = Field(0.2, ge=0, le=1, description="... else the line with most seam evidence, when it covers more than this share; else the middle.")
+
+
+class LineConfig(StageConfig):
+    """Seams supported by straight line segments that a learned detector (M-LSD) finds in the colour frames,
+    opt-in (perception/heuristic/line_evidence.py; the detector runs in react3d_models/line_segments.py).
+    Visibility along a segment is judged like the orthophotos' (``ortho.render_scale``, ``ortho.erode_px``,
+    ``ortho.edge_jump``, ``ortho.depth_tol``, ``ortho.depth_tol_rel``)."""
+
+    enabled: bool = Field(False, description="Run the line-segment detector on a few views of each plane and let seams that its segments support in several views cut cells (needs the ai-edge-litert package and the M-LSD weights; docs/perception.md).")
+    weights: str | None = Field(None, description="Path to the M-LSD tflite file (M-LSD_512_tiny_fp16.tflite or M-LSD_512_large_fp16.tflite from github.com/navervision/mlsd, tflite_models/); null: the environment variable REACT3D_MLSD_WEIGHTS.")
+    threads: int = Field(2, ge=1, description="CPU threads of the detector.")
+    min_score: float = Field(0.1, ge=0, le=1, description="Segment centres scoring below this are dropped (the detector's own threshold).")
+    min_length_px: float = Field(40.0, ge=0, description="Segments shorter than this (px of the detector's 512 px input) are dropped.")
+    max_frames: int = Field(24, ge=1, description="At most this many frames per scene go through the detector (its cost is per frame) ...")
+    views_per_plane: int = Field(6, ge=1, description="... each plane read in at most this many of them: those seeing most of it, spread apart (parallax moves what is not on the plane).")
+    max_angle_deg: float = Field(4.0, ge=0, le=45, description="A segment on the plane within this of vertical (of horizontal) is vertical (horizontal) line evidence (deg).")
+    tol: float = Field(0.015, ge=0, description="Segments of different views this close across (m) support the same line (pose and colour calibration errors move a line by a few cm between views).")
+    min_views: int = Field(2, ge=1, description="A grid pixel is on a learned line when segments of at least this many views pass through it.")
+    span: float = Field(0.6, ge=0, le=1, description="A learned line cuts a cell that dark lines and colour steps do not when it covers this share of the cell's length (and half of that in each of seams.span_chunks pieces).")
+
+
+class HandleConfig(StageConfig):
+    """Handles in the orthophotos and in the mesh (perception/heuristic/front_cells.py, image_fronts.py)."""
+
+    contrast: float = Field(0.12, ge=0, description="Colour distance of handle pixels from the local background.")
+    length: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
+    thickness: tuple[float, float] = Field((0.014, 0.07), description="Short side of a handle (m).")
+    aspect: float = Field(2.2, ge=1, description="Long side at least this times the short side.")
+    min_fill: float = Field(0.4, ge=0, le=1, description="A handle blob fills at least this share of its box.")
+    join_gap: float = Field(0.03, ge=0, description="Blob pieces this close along a row (m) are one handle (a bar broken by a highlight).")
+    min_seen_px: int = Field(100, ge=0, description="A plane with fewer seen orthophoto px has no handles.")
+    background_win: float = Field(0.12, gt=0, description="Window of the local background — of the colour, and of the surface a handle in the mesh stands out from (m).")
+    outline_margin: float = Field(0.02, ge=0, description="Colour blobs this close to the plane's outline are not handles (m).")
+    side_band: float = Field(0.02, gt=0, description="Width of the band around a handle (m) in which the plane's outline is looked for.")
+    around_cover: float = Field(0.4, ge=0, le=1, description="The plane's outline covers at least this share of the handle's box grown by side_band (a handle sits on a front).")
+    side_cover: float = Field(0.4, ge=0, le=1, description="The plane's outline covers at least this share of the side_band on each long side of a handle (out of the grid counts as uncovered): a handle sits on a front, a ridge at the plane's end (a wall corner, a unit's side) has the plane on one side only (RedKitchen: a door made from a ridge at the tiled wall's end). 0: off.")
+    protrusion_depth: tuple[float, float] = Field((0.012, 0.09), description="Mesh faces this far in front of the plane mark handles (m).")
+    protrusion_min_cos: float = Field(0.5, ge=-1, le=1, description="... facing outwards: the cosine between a face's normal and the plane's above this.")
+    protrusion_from_surface: bool = Field(True, description="Mesh handles stand protrusion_depth in front of the surface around them (median offset of the faces within background_win) instead of in front of the fitted plane, so a TSDF wall's bumps off its plane are no handles (heuristic version 14, with side_cover). Tuning scenes, front F1: TSDF 0.801 -> 0.812, laser 0.826 -> 0.834 (docs/perception.md).")
+    surface_block: float = Field(0.02, gt=0, description="The surface around a mesh handle: the median of per-block medians of the faces' offsets, in blocks of this size (m).")
+    bar_close_px: int = Field(5, ge=1, description="A mesh handle's splatted face centroids are closed with a kernel of this many px (they sit half a face inside its outline).")
+    shadows: bool = Field(True, description="On a front without a seen handle, an enclosed horizontal unseen hole of handle size above the cameras' median height is the handle's scanning shadow (a bar seen from below hides the front behind it in every view); it types the joint (wall-cabinet flaps), it does not cut cells.")
+    shadow_min_thick: float = Field(0.03, ge=0, description="A handle's scanning shadow is at least this tall (m).")
+
+
+class CellConfig(StageConfig):
+    """Cells of a plane's orthophoto (perception/heuristic/front_cells.py) and which become fronts (image_fronts.py)."""
+
+    min_side: float = Field(0.1, ge=0, description="No cell narrower than this (m).")
+    max_split_depth: int = Field(6, ge=0, description="Guillotine split recursion depth.")
+    outline_step: float = Field(0.5, ge=0, description="Where the covered extent across a line jumps by this share of the cell (an L-shaped outline: a tall unit beside a base run), the cell is cut there first; 0: off.")
+    min_seen: float = Field(0.55, ge=0, le=1, description="Share of a cell the plane's faces must cover.")
+    min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
+    handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")
+
+
+class ClutterConfig(StageConfig):
+    """Cluttered cells are no fronts (perception/heuristic/image_fronts.py): posters, tiles, shelves."""
+
+    max_share: float = Field(0.18, ge=0, le=1, description="Share of a cell's pixels off its local background above which it is clutter (posters, tiles, shelves).")
+    max_share_handle: float = Field(0.3, ge=0, le=1, description="The same share for a cell holding a handle (raised-panel doors shade their own faces; a handle is evidence of a front); never below max_share.")
+    cell_median: bool = Field(True, description="A pixel is clutter only when it is also off the cell's own median colour (a band along an edge shared with a front of another colour is not).")
+    median_min_px: int = Field(50, ge=0, description="... judged so only on cells with at least this many seen pixels outside the line structure.")
+    line_min_len: float = Field(0.15, ge=0, description="Straight horizontal/vertical lines at least this long (m) are a front's structure (shaker frames, tile joints), not clutter; 0 counts them.")
+    line_max_width: float = Field(0.02, ge=0, description="... and at most this thick (m).")
+
+
+# the earlier flat keys of perception.heuristic -> their section and name now (one place: the validator
+# below names the new key when a config still gives an old one)
+RENAMED: dict[str, str] = {
+    "facet_weld_m": "facets.weld_m",
+    "facet_max_angle_deg": "facets.max_angle_deg",
+    "render_scale": "render.scale",
+    "min_mask_px": "render.min_mask_px",
+    "n_probe": "probe.frames",
+    "probe_view_px": "probe.view_px",
+    "probe_min_views": "probe.min_views",
+    "probe_min_px": "probe.min_px",
+    "image_fronts": "image.enabled",
+    "texture_factor": "image.texture_factor",
+    "face_depth": "image.face_depth",
+    "outline_fill_px": "image.outline_fill_px",
+    "plain_floor_gap": "image.plain_floor_gap",
+    "floor_min_area": "floor.min_area",
+    "drawer_max_top": "reach.drawer_max_top",
+    "splashback": "splashback.enabled",
+    "splashback_min_z": "splashback.min_z",
+    "splashback_band": "splashback.band",
+    "splashback_reach": "splashback.reach",
+    "splashback_cover": "splashback.cover",
+    "room_wall": "room_wall.enabled",
+    "room_wall_behind_share": "room_wall.behind_share",
+    "room_wall_depth": "room_wall.depth",
+    "room_wall_min_area": "room_wall.min_area",
+    "room_door_min_h": "room_wall.door_min_h",
+    "room_door_w": "room_wall.door_w",
+    "room_door_floor_gap": "room_wall.door_floor_gap",
+    "sliding_track_offset": "sliding.track_offset",
+    "sliding_max_overlap": "sliding.max_overlap",
+    "sliding_max_gap": "sliding.max_gap",
+    "sliding_min_height_overlap": "sliding.min_height_overlap",
+    "sliding_min_parallel": "sliding.min_parallel",
+    "plane_offset_tol": "planes.offset_tol",
+    "plane_angle_tol_deg": "planes.angle_tol_deg",
+    "plane_refit_deg": "planes.refit_deg",
+    "plane_refit_min_gain": "planes.refit_min_gain",
+    "min_plane_area": "planes.min_area",
+    "plane_cell": "planes.cell",
+    "plane_min_fragment_area": "planes.min_fragment_area",
+    "ortho_resolution": "ortho.resolution",
+    "ortho_max_side_px": "ortho.max_side_px",
+    "max_views": "ortho.max_views",
+    "ortho_min_cos": "ortho.min_cos",
+    "ortho_render_scale": "ortho.render_scale",
+    "ortho_erode_px": "ortho.erode_px",
+    "ortho_edge_jump": "ortho.edge_jump",
+    "ortho_depth_tol": "ortho.depth_tol",
+    "ortho_margin": "ortho.margin",
+    "calibrate_colour": "calibration.enabled",
+    "calib_scale_range": "calibration.scale_range",
+    "calib_shift_range_px": "calibration.shift_range_px",
+    "calib_min_gain": "calibration.min_gain",
+    "register_sigmas_px": "registration.sigmas_px",
+    "register_prior_scale": "registration.prior_scale",
+    "register_prior_shift_px": "registration.prior_shift_px",
+    "seam_contrast": "seams.contrast",
+    "seam_span": "seams.span",
+    "seam_prominence": "seams.prominence",
+    "seam_prominence_h": "seams.prominence_h",
+    "seam_z": "seams.dip_z",
+    "step_contrast": "seams.step_contrast",
+    "step_z": "seams.step_z",
+    "step_over_dip": "seams.step_over_dip",
+    "handle_contrast": "handles.contrast",
+    "handle_len": "handles.length",
+    "handle_thick": "handles.thickness",
+    "handle_aspect": "handles.aspect",
+    "handle_background_win": "handles.background_win",
+    "handle_outline_margin": "handles.outline_margin",
+    "handle_side_cover": "handles.side_cover",
+    "handle_shadows": "handles.shadows",
+    "protrusion_depth": "handles.protrusion_depth",
+    "protrusion_from_surface": "handles.protrusion_from_surface",
+    "min_front_side": "cells.min_side",
+    "max_split_depth": "cells.max_split_depth",
+    "outline_step": "cells.outline_step",
+    "cell_min_seen": "cells.min_seen",
+    "min_tile_side": "cells.min_tile_side",
+    "handleless_min_seams": "cells.handleless_min_seams",
+    "max_clutter": "clutter.max_share",
+    "max_clutter_handle": "clutter.max_share_handle",
+    "clutter_cell_median": "clutter.cell_median",
+    "clutter_line_min_len": "clutter.line_min_len",
+    "clutter_line_max_width": "clutter.line_max_width",
+}
 
 
 class HeuristicConfig(StageConfig):
     """The weight-free heuristic: planar facets and fronts on the scan mesh, per-frame renders, and the
     image path (fronts found in the colour frames: seams, handles) and sliding-door pairs."""
 
+    facets: FacetConfig = Field(default_factory=FacetConfig, description="Planar facets of the scan mesh.")
+    probe: ProbeConfig = Field(default_factory=ProbeConfig, description="Which facets the cameras see.")
+    render: RenderConfig = Field(default_factory=RenderConfig, description="Per-frame front renders (masks).")
     fronts: FrontRulesConfig = Field(default_factory=FrontRulesConfig, description="Front rules on the scan mesh.")
-    facet_weld_m: float = Field(0.001, gt=0, description="Planar facets: vertices closer than this (m) are merged before joining faces.")
-    facet_max_angle_deg: float = Field(12.0, ge=0, le=180, description="Planar facets: faces sharing an edge join when their normals differ by at most this (deg).")
-    render_scale: float = Field(0.5, gt=0, le=1, description="Per-frame front renders at this fraction of the colour size (upsampled).")
-    n_probe: int = Field(24, ge=1, description="Frames (evenly spread) rendered at quarter size to find which facets the cameras see.")
-    probe_view_px: int = Field(4, ge=1, description="A facet counts as seen in a probe view with at least this many pixels ...")
-    probe_min_views: int = Field(2, ge=1, description="... and is visible when seen in this many probe views ...")
-    probe_min_px: int = Field(40, ge=0, description="... with at least this many pixels over all probe views.")
-    min_mask_px: int = Field(150, ge=0, description="A front yields a mask in a frame when it covers at least this many pixels there.")
+    floor: FloorConfig = Field(default_factory=FloorConfig, description="The floor's height.")
+    reach: ReachConfig = Field(default_factory=ReachConfig, description="Drawers are within reach.")
+    splashback: SplashbackConfig = Field(default_factory=SplashbackConfig, description="Splash-back above a worktop is no front.")
+    room_wall: RoomWallConfig = Field(default_factory=RoomWallConfig, description="Only room doors open on the room's outer walls.")
+    sliding: SlidingConfig = Field(default_factory=SlidingConfig, description="Sliding-door pairs.")
+    image: ImageConfig = Field(default_factory=ImageConfig, description="Fronts found in the colour frames.")
+    planes: PlanesConfig = Field(default_factory=PlanesConfig, description="Image path: large vertical planes of the mesh.")
+    ortho: OrthoConfig = Field(default_factory=OrthoConfig, description="Image path: fused plane orthophotos.")
+    calibration: CalibrationConfig = Field(default_factory=CalibrationConfig, description="Image path: colour self-calibration.")
+    registration: RegistrationConfig = Field(default_factory=RegistrationConfig, description="Image path: per-view colour registration (opt-in).")
+    seams: SeamConfig = Field(default_factory=SeamConfig, description="Image path: seams between fronts.")
+    lines: LineConfig = Field(default_factory=LineConfig, description="Image path: seams supported by learned line segments (opt-in).")
+    handles: HandleConfig = Field(default_factory=HandleConfig, description="Image path: handles.")
+    cells: CellConfig = Field(default_factory=CellConfig, description="Image path: cells and which become fronts.")
+    clutter: ClutterConfig = Field(default_factory=ClutterConfig, description="Image path: cluttered cells are no fronts.")
 
-    # image path: fronts in the colour frames
-    image_fronts: bool = Field(True, description="Also find fronts in the colour frames (real scans have no seams in the mesh).")
-    ortho_resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
-    max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
-    calibrate_colour: bool = Field(True, description="Self-calibrate colour focal scale / principal point against the mesh (unregistered RGB-D).")
-    seam_contrast: float = Field(0.01, ge=0, description="A seam pixel is this much darker than both sides (fraction of the plane's mean).")
-    seam_span: float = Field(0.35, ge=0, le=1, description="A seam covers this fraction of the cell it splits.")
-    seam_prominence: float = Field(0.3, ge=0, le=1, description="... and this much more than the lines around it (vertical seams).")
-    seam_prominence_h: float = Field(0.5, ge=0, le=1, description="The same for horizontal seams (reflections of table/shelf edges are horizontal).")
-    seam_z: float = Field(15.0, ge=0, description="A straight seam: the line's median brightness dips this many noise units below the lines beside it (found through wood grain).")
-    step_contrast: float = Field(0.25, ge=0, description="A colour step along a whole line (a door leaf in a pale wall) cuts when its colour distance is at least this ...")
-    step_z: float = Field(15.0, ge=0, description="... and this many noise units of the cell's steps.")
-    handle_contrast: float = Field(0.12, ge=0, description="Colour distance of handle pixels from the local background.")
-    handle_len: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
-    handle_thick: tuple[float, float] = Field((0.014, 0.07), description="Short side of a handle (m).")
-    plain_floor_gap: float = Field(0.03, ge=0, description="Image path: a handle-less front whose bottom edge is this close to the floor (m) is a piece of wall (base units stand on a plinth; room doors have handles); 0: no floor rule.")
-    floor_min_area: float = Field(0.5, ge=0, description="Image path: the floor is the lowest 2 cm band of upward-facing mesh holding at least this area (m^2), at its area-weighted median height; no such band: no floor rule.")
-    handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")
-    clutter_cell_median: bool = Field(True, description="Image cells: a pixel is clutter only when it is also off the cell's own median colour (a band along an edge shared with a front of another colour is not).")
-    step_over_dip: bool = Field(True, description="Image cells: a colour step along the whole cell that is stronger than the best dark line is the cut (a shaker frame casts a dark line inside its own edge).")
-    clutter_line_min_len: float = Field(0.15, ge=0, description="Image cells: straight horizontal/vertical lines at least this long (m) are a front's structure (shaker frames, tile joints), not clutter; 0 counts them.")
-    clutter_line_max_width: float = Field(0.02, ge=0, description="Image cells: ... and at most this thick (m).")
-    splashback: bool = Field(True, description="Drop fronts standing on a worktop flush with the wall behind it (splash-back: tiles, sockets).")
-    splashback_min_z: float = Field(0.5, ge=0, description="Splash-back: the worktop under the front's bottom edge is above this height (m).")
-    splashback_band: float = Field(0.08, ge=0, description="Splash-back: the worktop is this close to the front's bottom edge in height (m).")
-    splashback_reach: tuple[float, float] = Field((0.03, 0.33), description="Splash-back: the strip in front of the front examined for a worktop (m in front, from/to).")
-    splashback_cover: float = Field(0.2, ge=0, le=1, description="Splash-back: share of that strip the worktop must cover.")
-    room_wall: bool = Field(True, description="On the room's outer walls (planes with no scan surface behind them) keep only fronts shaped like room doors, typed as side-hinged doors (perception/heuristic/room_walls.py).")
-    room_wall_behind_share: float = Field(0.005, ge=0, le=1, description="Outer wall: less than this share of the scan's surface area lies behind the front's plane ...")
-    room_wall_depth: float = Field(0.1, ge=0, description="... more than this far (m) ...")
-    room_wall_min_area: float = Field(1.0, ge=0, description="... and the plane holds at least this much other surface (m^2) outside every front (a lone cabinet scanned from the front has no wall).")
-    room_door_min_h: float = Field(1.8, gt=0, description="Room door on an outer wall: at least this tall (m) ...")
-    room_door_w: tuple[float, float] = Field((0.6, 1.3), description="... this wide (min, max; m) ...")
-    room_door_floor_gap: float = Field(0.05, ge=0, description="... and its bottom edge this close to the floor (m).")
-    drawer_max_top: float = Field(1.7, ge=0, description="A drawer's top edge is at most this high above the floor (m): nothing slides out above eye level; a drawer-typed strip higher up is dropped (perception/heuristic/reach.py); 0: no limit.")
-    min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
-    sliding_track_offset: tuple[float, float] = Field((0.008, 0.06), description="Sliding doors: plane offset between two side-by-side fronts on two tracks (m).")
-    sliding_max_overlap: float = Field(0.12, ge=0, description="Sliding doors: the two fronts' outlines overlap by at most this (m).")
-    sliding_max_gap: float = Field(0.02, ge=0, description="Sliding doors: ... or leave at most this gap between them (m).")
-    sliding_min_height_overlap: float = Field(0.9, ge=0, le=1, description="Sliding doors: share of the smaller height the two fronts share.")
-    sliding_min_parallel: float = Field(0.97, ge=0, le=1, description="Sliding doors: |cos| between the two fronts' normals at least this.")
-    plane_offset_tol: float = Field(0.025, ge=0, description="Image path: faces this close to a vertical plane belong to it (m).")
-    plane_angle_tol_deg: float = Field(12.0, ge=0, description="Image path: faces whose normal is within this of a plane's belong to it (deg).")
-    plane_refit_deg: float = Field(3.0, ge=0, description="Image path: a plane at least 1 m wide takes, within this of its normals' mean direction, the direction along which its faces' positions are sharpest (a curved appliance door skews the normals; deg, 0: off).")
-    plane_refit_min_gain: float = Field(1.4, ge=1, description="Image path: ... only when the offsets are at least this many times sharper (integral of the squared density) than along the normals' direction.")
-    min_plane_area: float = Field(0.08, ge=0, description="Image path: smallest vertical plane photographed (m^2; at least min_w x min_h).")
-    plane_cell: float = Field(0.04, gt=0, description="Image path: pieces of one plane farther apart than this are separate planes (m).")
-    plane_min_fragment_area: float = Field(0.03, ge=0, description="Image path: fragments of a plane's coverage smaller than this are not part of it (m^2).")
-    face_depth: tuple[float, float] = Field((-0.02, 0.07), description="Image path: faces this far behind/in front of the plane are taken into a front (m).")
-    outline_fill_px: int = Field(20, ge=0, description="Image path: holes and notches up to this many orthophoto px wide are inside a plane's outline (handle shadows).")
-    protrusion_depth: tuple[float, float] = Field((0.012, 0.09), description="Image path: mesh faces this far in front of the plane mark handles (m).")
-    protrusion_from_surface: bool = Field(True, description="Image path: mesh handles stand protrusion_depth in front of the surface around them (median offset of the faces within handle_background_win) instead of in front of the fitted plane, so a TSDF wall's bumps off its plane are no handles (heuristic version 14, with handle_side_cover). Tuning scenes, front F1: TSDF 0.801 -> 0.812, laser 0.826 -> 0.834 (docs/perception.md).")
-    ortho_max_side_px: int = Field(1200, ge=1, description="Orthophotos of very large planes get a coarser grid, at most this many px a side.")
-    ortho_min_cos: float = Field(0.3, ge=0, le=1, description="Orthophotos: views more grazing than this cos to the plane are not used.")
-    ortho_render_scale: float = Field(0.5, gt=0, le=1, description="Orthophotos: face-id buffer size relative to the colour image.")
-    ortho_erode_px: int = Field(3, ge=0, description="Orthophotos: depth-buffer pixels kept this far from depth jumps (occluder outlines).")
-    ortho_edge_jump: float = Field(0.05, gt=0, description="Orthophotos: a depth jump between neighbouring pixels marking an outline (m).")
-    ortho_depth_tol: float = Field(0.03, ge=0, description="Orthophotos: a plane point is seen when the scan is within this (m, +1 % of the distance).")
-    ortho_margin: float = Field(0.02, ge=0, description="Orthophotos: grid margin around a plane's extent (m).")
-    calib_scale_range: tuple[float, float] = Field((0.84, 1.12), description="Colour calibration: focal scales searched.")
-    calib_shift_range_px: float = Field(16.0, ge=0, description="Colour calibration: principal-point shifts searched (px at 640 px width).")
-    calib_min_gain: float = Field(0.2, ge=0, le=1, description="Colour calibration: used only when it cuts the disagreement by this fraction.")
-    register_sigmas_px: tuple[float, ...] = Field((), description="Per-view colour registration, opt-in: image blur per coarse-to-fine level (px at 640 px width), e.g. [12, 6, 3, 1.5]; () = off. For RGB-D whose colour is not synchronised with depth (docs/perception.md: what it gains and costs).")
-    register_prior_scale: float = Field(0.08, gt=0, description="Per-view colour registration: prior std of a view's focal scale and aspect around the scene calibration.")
-    register_prior_shift_px: float = Field(30.0, gt=0, description="Per-view colour registration: prior std of a view's shift (px at 640 px width).")
-    min_front_side: float = Field(0.1, ge=0, description="Image cells: no cell narrower than this (m).")
-    handle_aspect: float = Field(2.2, ge=1, description="Image handles: long side at least this times the short side.")
-    handle_background_win: float = Field(0.12, gt=0, description="Image handles: window of the local background — of the colour, and of the surface a handle in the mesh stands out from (m).")
-    cell_min_seen: float = Field(0.55, ge=0, le=1, description="Image cells: share of a cell the plane's faces must cover.")
-    max_clutter: float = Field(0.18, ge=0, le=1, description="Image cells: share of a cell's pixels off its local background above which it is clutter (posters, tiles, shelves).")
-    max_clutter_handle: float = Field(0.3, ge=0, le=1, description="Image cells: the same share for a cell holding a handle (raised-panel doors shade their own faces; a handle is evidence of a front); never below max_clutter.")
-    handle_side_cover: float = Field(0.4, ge=0, le=1, description="Image handles: the plane's outline covers at least this share of the 2 cm band on each long side of a handle (out of the grid counts as uncovered): a handle sits on a front, a ridge at the plane's end (a wall corner, a unit's side) has the plane on one side only (RedKitchen: a door made from a ridge at the tiled wall's end). 0: off.")
-    handle_outline_margin: float = Field(0.02, ge=0, description="Image handles: colour blobs this close to the plane's outline are not handles (m).")
-    handle_shadows: bool = Field(True, description="Image handles: on a front without a seen handle, an enclosed horizontal unseen hole of handle size above the cameras' median height is the handle's scanning shadow (a bar seen from below hides the front behind it in every view); it types the joint (wall-cabinet flaps), it does not cut cells.")
-    texture_factor: float = Field(3.0, ge=0, description="Image path: handle/seam thresholds rise to this many times the plane's median response (textured planes).")
-    max_split_depth: int = Field(6, ge=0, description="Image cells: guillotine split recursion depth.")
-    outline_step: float = Field(0.5, ge=0, description="Image cells: where the covered extent across a line jumps by this share of the cell (an L-shaped outline: a tall unit beside a base run), the cell is cut there first; 0: off.")
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed_keys(cls, data: Any) -> Any:
+        """A key of the earlier flat layout gets its new name in the error, not just 'extra forbidden'."""
+        if isinstance(data, dict):
+            # 'splashback' and 'room_wall' are sections now: only their old boolean form is the old key
+            old = [k for k in RENAMED if k in data and not (k in cls.model_fields and isinstance(data[k], dict | StageConfig))]
+            if old:
+                raise ValueError("; ".join(f"perception.heuristic.{k} is now perception.heuristic.{RENAMED[k]}" for k in old))
+        return data

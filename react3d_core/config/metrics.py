@@ -12,6 +12,8 @@ class EvaluationConfig(StageConfig):
     horizontal_deg: float = Field(45.0, description="Revolute axis is horizontal if its angle with the ground < this.")
     oe_deg: float = Field(10.0, description="+MO: axis error below this (deg).")
     md_factor: float = Field(0.25, description="+MOD: MD below this x GT part mesh diagonal.")
+    box_below_coverage: float = Field(0.5, ge=0, le=1, description="A GT part whose annotation gives its box and a scan coverage below this (or no scan vertices) is matched by front-box IoU instead of vertex IoU.")
+    box_slab_tol: float = Field(0.05, ge=0, description="Front-box IoU: a prediction's box must lie within the GT front's slab grown by this (m) on both sides.")
     miss_iou: float = Field(0.5, ge=0, le=1, description="Miss causes: a GT part below this vertex IoU is traced through the stages.")
     cause_min_views: int = Field(2, ge=1, description="Miss causes: fewer masks than this on a part = never masked in enough views.")
     cause_view_precision: float = Field(0.5, ge=0, le=1, description="Miss causes: a mask is on a part if this share of its faces is the part's ...")

@@ -1,14 +1,13 @@
 """Perception backends and their thresholds (tags, 2D masks, point prompts, articulation predictor)."""
 
-import re
-from typing import Literal
-from urllib.parse import parse_qsl, urlsplit
+from typing import Any, Literal
 
-from pydantic import Field, ValidationInfo, field_validator
+from pydantic import Field, model_validator
 
 from ..errors import ConfigError
 from ._base import StageConfig
 from .heuristic import HeuristicConfig
+from .models import MOVED_TO_MODELS, ModelsConfig
 
 
 class OracleNoiseConfig(StageConfig):
@@ -35,56 +34,22 @@ class PerceptionConfig(StageConfig):
     backend: Literal["heuristic", "oracle", "models"] = Field(
         "heuristic", description="heuristic: weight-free RGB-D; oracle: ground truth (+noise); models: foundation models."
     )
-    box_threshold: float = Field(0.3, ge=0, le=1, description="Grounding DINO box threshold (paper: 0.3).")
-    text_threshold: float = Field(0.25, ge=0, le=1, description="Grounding DINO text threshold (paper: 0.25).")
     always_keep_tags: tuple[str, ...] = Field(("door",), description="Tags kept whatever the tag filter says.")
     prompt_suffix: str = Field(" door", description="Phrase for openable tags, e.g. 'cabinet' -> 'cabinet door'.")
     hole_close_px: int = Field(30, ge=0, description="Closing kernel (px at 960x720) that fills missed handles in masks.")
-    detector_model: str = Field("IDEA-Research/grounding-dino-tiny", description="Open-vocabulary detector (hub id or local path).")
-    sam_model: str = Field("facebook/sam-vit-huge", description="SAM (hub id or local path).")
-    tagger_model: str = Field("xinyu1205/recognize-anything-plus-model", description="Image tagger (RAM++ or alternative).")
-    tag_filter_endpoint: str | None = Field(None, description="OpenAI-compatible chat endpoint for the openable-tag filter.")
-    tag_filter_model: str = Field("llava-hf/llava-1.5-7b-hf", description="Tag-filter language model (endpoint model name or local id).")
-    articulation_endpoint: str | None = Field(None, description="OPDMulti HTTP endpoint or command (JSON contract).")
-    batch_size: int = Field(8, ge=1, description="Frames per model call on GPU.")
-    device: str = Field("auto", description="'auto', 'cpu', 'cuda', 'cuda:N'.")
+    batch_size: int = Field(8, ge=1, description="Frames per perception call (one Prefect task), whatever the backend.")
     oracle: OracleNoiseConfig = Field(default_factory=OracleNoiseConfig, description="Oracle backend: how imperfect its ground truth is made.")
     heuristic: HeuristicConfig = Field(default_factory=HeuristicConfig, description="Heuristic backend: facets, front rules, image path, sliding doors.")
+    models: ModelsConfig = Field(default_factory=ModelsConfig, description="Models backend: weights, device, dtype, thresholds, endpoints.")
 
-    @field_validator("tag_filter_endpoint", "articulation_endpoint")
+    @model_validator(mode="before")
     @classmethod
-    def _no_credentials(cls, value: str | None, info: ValidationInfo) -> str | None:
-        """Endpoints are recorded in scene.json and in Prefect's flow-run parameters, so they must not carry a
-        secret: keys come from the environment (REACT3D_LLM_API_KEY / OPENAI_API_KEY,
-        REACT3D_OPDMULTI_API_KEY) or a Prefect Secret block, never from the config."""
-        if value:
-            where = endpoint_credential(value)
-            if where:
-                field = info.field_name
-                # ConfigError, not ValueError: pydantic would wrap a ValueError and echo the input (the key)
-                raise ConfigError(f"perception.{field} carries a credential ({where}); it would be stored in scene.json "
-                                 "and Prefect's run parameters. Remove it and set the key in the environment "
-                                 "(REACT3D_LLM_API_KEY, REACT3D_OPDMULTI_API_KEY; docs/reliability.md) "
-                                 "or in a Prefect Secret block")
-        return value
-
-
-_URL = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*://[^\s'\"]+")
-_SECRET_NAME = re.compile(r"^(.*[-_])?(api[-_]?key|key|token|access[-_]?token|secret|password|passwd|pwd|auth|"
-                          r"authorization|signature|sig|credentials?)$", re.IGNORECASE)
-_SECRET_FLAG = re.compile(r"(?:^|\s)--?(api[-_]?key|token|access[-_]?token|secret|password|auth)(?:[=\s]|$)", re.IGNORECASE)
-
-
-def endpoint_credential(value: str) -> str | None:
-    """Where ``value`` (a URL, or a command that may contain URLs) carries a credential, else None:
-    user info in a URL, a query parameter named like a key/token, or a ``--api-key``-style flag."""
-    for url in _URL.findall(value):
-        parts = urlsplit(url)
-        if "@" in parts.netloc:
-            return "user name/password in the URL"
-        for name, _ in parse_qsl(parts.query, keep_blank_values=True):
-            if _SECRET_NAME.match(name):
-                return f"query parameter {name!r}"
-    m = _SECRET_FLAG.search(value)
-    return f"command-line flag {m.group(0).strip().split('=')[0]!r}" if m else None
-
+    def _moved_keys(cls, data: Any) -> Any:
+        """The model backend's settings moved into ``perception.models``: say where, instead of 'extra inputs
+        are not permitted' (the value is not echoed: an endpoint may carry a key)."""
+        if isinstance(data, dict):
+            moved = [k for k in MOVED_TO_MODELS if k in data]
+            if moved:
+                raise ConfigError("; ".join(f"perception.{k} is now perception.models.{k}" for k in moved)
+                                  + " (the models backend's settings are one section: docs/perception_models.md)")
+        return data

@@ -9,7 +9,7 @@ class FrameSelectionConfig(StageConfig):
     """Frame selection. Default (``stride`` None): keyframes by what the views add — camera motion since
     the last kept frame, then new or under-observed surface in a low-resolution face-id buffer — capped
     at ``keyframe_cap``. A fixed stride suits one frame rate only (stride 5 kept 12 of a sparse
-    60-frame capture, issue 16); an explicit ``stride`` is still honoured as given."""
+    60-frame capture); an explicit ``stride`` is still honoured as given."""
 
     stride: int | None = Field(None, ge=1, description="Use every n-th frame; None selects keyframes by motion and coverage.")
     max_frames: int | None = Field(None, ge=1, description="Explicit cap on the number of frames (evenly subsampled), any mode.")

@@ -132,7 +132,7 @@ class SceneInput(BaseModel):
     root: Path
     mesh_path: Path
     frames: tuple[Frame, ...]
-    source_format: str = Field(description="'scannetpp_iphone', 'scannetpp_dslr', 'prepared', 'generic', 'synthetic'.")
+    source_format: str = Field(description="The input layout it was loaded from: 'scannetpp_iphone', 'prepared', 'generic', 'scannetpp_dslr' (scene_io.LAYOUTS).")
     gt_dir: Path | None = Field(None, description="Folder with Articulate3D <scan>_parts.json / _artic.json.")
     notes: tuple[str, ...] = Field((), description="Non-fatal problems found while loading.")
     frame_selection: str = Field("", description="How the frames were chosen: kept N of M and by which rule.")

@@ -162,6 +162,10 @@ class InteractiveScene(BaseModel):
     export_sizes: dict[str, int] = Field(
         default_factory=dict, description="bytes of export/: shared 'assets', each format's own files, and 'total'"
     )
+    physics: dict[str, Any] | None = Field(
+        None, description="Summary of the physics check (react3d_core.physics): per engine its summary line, the verdict; "
+        "the full result is in the file it names (physics_check.json)."
+    )
     created: str = Field(default_factory=lambda: datetime.now(timezone.utc).isoformat(timespec="seconds"))
 
     def save(self, path: str | Path) -> Path:

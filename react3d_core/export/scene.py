@@ -107,5 +107,6 @@ def export_scene(manifest_path: str | Path, formats: tuple[str, ...] | list[str]
         sizes = size_report(tmp, formats)
     out = {fmt: target / entry_file(fmt, config) for fmt in formats}
     exports = {fmt: (Path("export") / entry_file(fmt, config)).as_posix() for fmt in formats}
-    scene.model_copy(update={"exports": exports, "export_sizes": sizes}).save(manifest_path)
+    # a new export invalidates an earlier physics check of the old one
+    scene.model_copy(update={"exports": exports, "export_sizes": sizes, "physics": None}).save(manifest_path)
     return out

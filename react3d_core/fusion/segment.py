@@ -91,7 +91,7 @@ def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh, config: FusionCon
     """Proposals of several Louvain resolutions often re-segment to the same part, or to a piece of
     it (seen cut off in their best view): keep the best-scored candidate, drop later ones with
     vertex IoU > ``duplicate_iou`` or > ``duplicate_contained`` of their vertices inside a kept one
-    (issue 4's dedup still runs later)."""
+    (the dedup stage still runs later)."""
     order = sorted(cands, key=lambda c: (-c.score, -len(c.face_ids)))
     inter, size, _ = overlap_counts([c.vertex_ids for c in order])
     union = size[:, None] + size[None, :] - inter

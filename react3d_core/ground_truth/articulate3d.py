@@ -2,6 +2,12 @@
 
 Movable parts = the pids listed in ``articulations``. Axes are normalised on read (sign arbitrary);
 ranges are radians for rotation and metres for translation; everything is in the mesh frame.
+
+Two optional annotation keys extend the format for parts a scan may lack (synthetic scenes write them
+where a scan can miss surface: depth dropped on dark fronts, see docs/evaluation.md): ``obb`` (the
+part's true box in the closed state: ``center``, ``axes`` (rows), ``extents``) and ``scanCoverage``
+(the share of the part's observed opaque surface that the scan mesh holds, 0..1). Readers that do not
+know them ignore them; files without them read as before.
 """
 
 from __future__ import annotations
@@ -13,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_json
-from ..data.parts import Articulation
+from ..data.parts import OBB, Articulation
 from ..errors import InputError
 
 
@@ -27,6 +33,8 @@ class GTPart:
     vert_indices: np.ndarray
     articulation: Articulation | None = None
     base: list[int] = field(default_factory=list)
+    obb: OBB | None = None            # true box of the part (closed), where the annotation gives it
+    coverage: float | None = None     # share of its observed surface the scan holds, where given
 
     @property
     def movable(self) -> bool:
@@ -104,6 +112,13 @@ def read_articulate3d(gt_dir: str | Path, scene_id: str | None = None) -> Ground
             )
         except (KeyError, TypeError, ValueError) as exc:
             raise InputError(parts_p, f"annotation {i}: bad or missing field ({exc})") from None
+        try:
+            if "obb" in a:
+                part.obb = OBB(center=a["obb"]["center"], axes=a["obb"]["axes"], extents=a["obb"]["extents"])
+            if "scanCoverage" in a:
+                part.coverage = float(a["scanCoverage"])
+        except (KeyError, TypeError, ValueError) as exc:
+            raise InputError(parts_p, f"annotation {i} (partId {pid}): bad obb or scanCoverage ({exc})") from None
         if pid in arts:
             art = arts[pid]
             try:
@@ -132,15 +147,21 @@ def write_articulate3d(gt_dir: str | Path, gt: GroundTruth) -> tuple[Path, Path]
     """Write ``<scan>_parts.json`` and ``<scan>_artic.json`` (atomically)."""
     gt_dir = Path(gt_dir)
     parts_p, artic_p = _paths(gt_dir, gt.scene_id)
-    anns = [
-        {
+    anns = []
+    for p in gt.parts:
+        ann: dict = {
             "partId": int(p.part_id),
             "label": p.label,
             "triIndices": [int(x) for x in p.tri_indices],
             "vertIndices": [int(x) for x in p.vert_indices],
         }
-        for p in gt.parts
-    ]
+        if p.obb is not None:
+            ann["obb"] = {"center": [round(float(x), 6) for x in p.obb.center],
+                          "axes": [[round(float(x), 6) for x in ax] for ax in p.obb.axes],
+                          "extents": [round(float(x), 6) for x in p.obb.extents]}
+        if p.coverage is not None:
+            ann["scanCoverage"] = round(float(p.coverage), 4)
+        anns.append(ann)
     stats = {"totalFaces": gt.total_faces, "totalVertices": gt.total_vertices, "totalParts": len(gt.parts)}
     arts = []
     for p in gt.parts:

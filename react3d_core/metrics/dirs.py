@@ -10,8 +10,8 @@ from ..config.metrics import EvaluationConfig
 from ..data.parts import InteractiveScene
 from ..errors import InputError
 from ..ground_truth.articulate3d import read_articulate3d
-from .report import write_report
 from .scene_metrics import SceneMetrics, evaluate_scene, to_json_dict
+from .tables import write_tables
 
 
 def find_pairs(pred_dir: str | Path, gt_dir: str | Path) -> list[tuple[Path, Path]]:
@@ -57,6 +57,6 @@ def run_evaluation(pred_dir: str | Path, gt_dir: str | Path, out_dir: str | Path
     scenes = evaluate_dirs(pred_dir, gt_dir, EvaluationConfig(**(config or {})))
     result = to_json_dict(scenes)
     if out_dir is not None:
-        write_report(out_dir, scenes)
+        write_tables(out_dir, scenes)
         write_json(Path(out_dir) / "metrics.json", result)
     return result

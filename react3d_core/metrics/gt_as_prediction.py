@@ -41,9 +41,11 @@ def gt_to_scene(gt: GroundTruth, mesh_path: str | Path, out_dir: str | Path) -> 
         save_mesh(out_dir / "parts" / f"{part.part_id}.ply", sub)
         art = part.articulation
         assert art is not None  # movable parts carry one
+        # the true box where the annotation gives it (a part the scan lacks has few or no vertices)
+        obb = part.obb if part.obb is not None else _aabb(mesh.vertices[vids])
         objects.append(
             InteractiveObject(
-                object_id=f"gt_{part.part_id}", label=part.label, articulation=art, obb=_aabb(mesh.vertices[vids]),
+                object_id=f"gt_{part.part_id}", label=part.label, articulation=art, obb=obb,
                 front_normal=(1.0, 0.0, 0.0), part_mesh=f"parts/{part.part_id}.ply",
                 source_vertex_ids=f"parts/{part.part_id}_vertex_ids.npz",
             )

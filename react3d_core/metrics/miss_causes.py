@@ -1,4 +1,4 @@
-"""Miss-cause breakdown (issue 16): for each GT part that is missed or scored below IoU 0.5, the stage
+"""Miss-cause breakdown: for each GT part that is missed or scored below IoU 0.5, the stage
 where it was lost; for each matched part with a large axis or hinge error, the cause where it can be told.
 
 Why: F1 and OE say *that* parts are lost, not *where*; fixing the pipeline needs the stage. The trace is
@@ -9,6 +9,9 @@ from a traced run), in pipeline order; the first stage after which no output sti
 ``coincident_gt``          the GT part shares its place with another GT part (their boxes overlap by more
                            than half the smaller): two objects stacked in one spot by the scene
                            generator, whose surfaces z-fight; no pipeline can return both
+``no_scan_surface``        the GT part is scored by its box (the scan holds under ``box_below_coverage``
+                           of its surface: a dark front the depth sensor missed) and no prediction's box
+                           matches it; the stage trace of its remaining surface is kept as ``trace_cause``
 ``not_seen``               no frame sees the part at all
 ``not_masked``             fewer than ``cause_min_views`` 2D masks lie on the part (perception; judged on
                            the GT part-id images where the scene has them, else on the scan's faces)
@@ -56,7 +59,7 @@ from ..config.metrics import EvaluationConfig
 from ..data.parts import OBB, Articulation
 from .geometry import axis_error_deg, joint_class, line_distance
 
-MISS_CAUSES = ("coincident_gt", "not_seen", "not_masked", "off_scan_surface", "filled_through", "lost_in_lifting", "lost_in_fusion", "merged", "split", "no_top_view",
+MISS_CAUSES = ("coincident_gt", "no_scan_surface", "not_seen", "not_masked", "off_scan_surface", "filled_through", "lost_in_lifting", "lost_in_fusion", "merged", "split", "no_top_view",
                "merged_in_reseg", "resegmentation", "clipped", "duplicate_dropped", "rejected_by_validation",
                "dropped_by_dedup", "unobserved_geometry", "other")
 JOINT_CAUSES = ("type_wrong", "sliding_not_flagged", "obb_tilt", "not_refined", "wrong_obb_axis", "far_edge",
@@ -308,6 +311,8 @@ def attribute_scene(gt_faces: dict[int, np.ndarray], gt_arts: dict[int, Articula
                 cause, info = "coincident_gt", {"eval_iou": float(r["iou"])}
             else:
                 cause, info = miss_cause(gt_faces[pid], float(r["iou"]), st, cfg, pid)
+                if r.get("scored_by") == "box":
+                    cause, info = "no_scan_surface", {**info, "trace_cause": cause}
             counts["miss"][cause] += 1
             parts.append({"gt_part": pid, "kind": "miss", "causes": [cause], **info})
             continue

@@ -4,6 +4,11 @@ Detection: a prediction is a TP at tau if its vertex IoU with >= 1 GT part is > 
 TP predictions / predictions, recall = GT parts matched / GT parts. Articulation (joint accuracy,
 OE, MD) is scored on TP predictions, each matched to its best-IoU GT part. MOD is cumulative over
 GT parts; each matched GT part is judged by its best-IoU prediction among those above tau.
+
+A GT part the scan mostly lacks (its annotation gives its true box and a scan coverage below
+``box_below_coverage``, e.g. a black front the depth sensor missed) cannot be scored by vertex IoU: a
+prediction of it has no scan vertices to share. Its column uses the front-box IoU instead
+(:func:`front_box_iou`); everything else is unchanged (docs/evaluation.md).
 """
 
 from __future__ import annotations
@@ -16,9 +21,9 @@ import numpy as np
 
 from ..config.metrics import EvaluationConfig
 from ..data.mesh import load_mesh
-from ..data.parts import Articulation, InteractiveScene, load_vertex_ids
+from ..data.parts import OBB, Articulation, InteractiveScene, load_vertex_ids
 from ..errors import InputError
-from ..ground_truth.articulate3d import GroundTruth
+from ..ground_truth.articulate3d import GroundTruth, GTPart
 from ..geometry import iou_matrix
 from .geometry import axis_error_deg, joint_class, line_distance
 
@@ -80,6 +85,30 @@ def compare_joints(pred: Articulation, gt: Articulation, config: EvaluationConfi
     return PairScore(True, oe, md)
 
 
+def front_box_iou(pred: OBB, gt: OBB, slab_tol: float = 0.05) -> float:
+    """IoU of two boxes as fronts: their outlines projected on the GT box's front plane (spanned by its
+    two longest sides), 0 unless the predicted box lies within the GT slab (its extent along the GT's
+    shortest side) grown by ``slab_tol`` on both sides (a misplaced plane or a whole-cabinet box)."""
+    import cv2
+
+    R = gt.R
+    ext = np.asarray(gt.extents, float)
+    rel = pred.corners() - np.asarray(gt.center, float)
+    along = rel @ R[:, 2]
+    half = ext[2] / 2 + slab_tol
+    if along.min() < -half - 1e-9 or along.max() > half + 1e-9:
+        return 0.0
+    hull = cv2.convexHull((rel @ R[:, :2]).astype(np.float32))
+    a, b = ext[0] / 2, ext[1] / 2
+    rect = np.array([[-a, -b], [a, -b], [a, b], [-a, b]], np.float32)
+    area_p = float(cv2.contourArea(hull))
+    if area_p <= 0.0:
+        return 0.0
+    inter, _ = cv2.intersectConvexConvex(hull, rect)
+    union = area_p + 4 * a * b - float(inter)
+    return float(inter) / union if union > 0 else 0.0
+
+
 def _gt_diagonals(gt_sets: list[np.ndarray], vertices: np.ndarray | None) -> list[float | None]:
     out: list[float | None] = []
     for s in gt_sets:
@@ -102,10 +131,23 @@ def evaluate_sets(
     vertices: np.ndarray | None,
     config: EvaluationConfig,
     scene: str = "",
+    pred_boxes: list[OBB] | None = None,
+    gt_boxes: list[OBB | None] | None = None,
 ) -> SceneMetrics:
-    """Core of :func:`evaluate_scene` on plain arrays (what the tests drive by hand)."""
+    """Core of :func:`evaluate_scene` on plain arrays (what the tests drive by hand).
+
+    ``gt_boxes[j]`` (given only for GT parts the scan lacks) switches GT part j to front-box IoU with
+    ``pred_boxes`` (:func:`front_box_iou`); its diagonal for +MOD is then the box's."""
     iou = iou_matrix(pred_sets, gt_sets)
     diags = _gt_diagonals(gt_sets, vertices)
+    boxed = [gt_boxes is not None and gt_boxes[j] is not None for j in range(len(gt_sets))]
+    if any(boxed):
+        if pred_boxes is None or len(pred_boxes) != len(pred_sets):
+            raise ValueError("GT parts scored by box need a box per prediction")
+        for j in np.flatnonzero(boxed):
+            gb = gt_boxes[j]  # type: ignore[index]
+            iou[:, j] = [front_box_iou(pb, gb, config.box_slab_tol) for pb in pred_boxes]
+            diags[j] = float(np.linalg.norm(gb.extents))
     n_pred, n_gt = len(pred_sets), len(gt_sets)
     pairs = {(i, j): compare_joints(pred_arts[i], gt_arts[j], config) for i in range(n_pred) for j in range(n_gt) if iou[i, j] > 0}
     counts: dict[str, ThresholdCounts] = {}
@@ -126,6 +168,7 @@ def evaluate_sets(
                 "scene": scene, "tau": float(tau), "gt_part": int(gt_ids[j]), "gt_type": joint_class(gt_arts[j], config.horizontal_deg),
                 "diag": diags[j], "matched": False, "pred": None, "iou": float(iou[:, j].max()) if n_pred else 0.0,
                 "pred_type": None, "type_ok": False, "oe": None, "md": None, "mo": False, "mod": False,
+                "scored_by": "box" if boxed[j] else "vertices",
             }
             if n_pred and above[:, j].any():
                 i = int(np.argmax(np.where(above[:, j], iou[:, j], -1.0)))
@@ -146,6 +189,16 @@ def evaluate_sets(
     return SceneMetrics(scene=scene, n_gt=n_gt, n_pred=n_pred, counts=counts, parts=rows)
 
 
+def box_scored_box(part: GTPart, n_vertices: int, config: EvaluationConfig) -> OBB | None:
+    """The part's box when it is scored by box (it has one, and the scan holds under
+    ``box_below_coverage`` of its surface or none of its vertices), else None."""
+    if part.obb is None:
+        return None
+    if n_vertices == 0 or (part.coverage is not None and part.coverage < config.box_below_coverage):
+        return part.obb
+    return None
+
+
 def evaluate_scene(
     pred: InteractiveScene, pred_dir: Path, gt: GroundTruth, config: EvaluationConfig, vertices: np.ndarray | None = None
 ) -> SceneMetrics:
@@ -162,12 +215,13 @@ def evaluate_scene(
     gt_sets_d = gt.movable_vertex_sets(include_children=True)
     gt_ids = list(gt_sets_d)
     by_id = {p.part_id: p for p in gt.movable}
+    gt_boxes = [box_scored_box(by_id[k], len(gt_sets_d[k]), config) for k in gt_ids]
     if vertices is None:
         mesh_path = Path(pred.input_mesh)
         mesh_path = mesh_path if mesh_path.is_absolute() else pred_dir / mesh_path
         vertices = load_mesh(mesh_path).vertices
     sm = evaluate_sets(pred_sets, pred_arts, gt_ids, [gt_sets_d[k] for k in gt_ids], [by_id[k].articulation for k in gt_ids],
-                       vertices, config, scene=pred.scene_id)
+                       vertices, config, scene=pred.scene_id, pred_boxes=[o.obb for o in pred.objects], gt_boxes=gt_boxes)
     sm.faces = gt.total_faces
     sm.stages = {k: float(v) for k, v in pred.timings.items()}
     return sm

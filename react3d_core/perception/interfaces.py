@@ -2,7 +2,7 @@
 
 Backends (DESIGN.md): ``heuristic`` (weight-free, RGB-D only, in react3d_core.perception.heuristic),
 ``oracle`` (ground truth + configurable noise, react3d_core.perception.oracle) and ``models``
-(foundation models, tasks/models/ — the only code that loads weights). Every call takes a batch of
+(foundation models, react3d_models/ — the only code that loads weights). Every call takes a batch of
 frames so GPU backends can batch; images are passed as arrays at the frame's RGB resolution.
 """
 

@@ -5,17 +5,17 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 5: straight seams by line median, handle shadows filled, texture-adaptive clutter; 6: splash-back rule,
 # colour steps beat weaker dark lines, line structure and the cell's own colour in the clutter test;
 # 7: enclosed handle-shaped unseen holes are handles (wall-cabinet flaps), mirrored background border;
-# 8: a cell holding a handle may be more cluttered (max_clutter_handle 0.3: raised-panel doors);
-# 9: a handle-less image front reaching down to the floor is wall (plain_floor_gap);
-# 10: a wide vertical plane's direction is refit from its faces' positions (plane_refit_deg)
+# 8: a cell holding a handle may be more cluttered (clutter.max_share_handle 0.3: raised-panel doors);
+# 9: a handle-less image front reaching down to the floor is wall (image.plain_floor_gap);
+# 10: a wide vertical plane's direction is refit from its faces' positions (planes.refit_deg)
 # 11: handles in the mesh skip the colour opening (a 3-4 px bar fell apart) and are grown by 1 px
 # 12: on the room's outer walls (no scan surface behind the plane) only room-door-shaped fronts stay,
-#     typed as side-hinged doors (room_wall)
-# 13: image cells are cut first at an L-shaped outline's corner (outline_step); drawer-typed fronts
-#     above 1.7 m are dropped (drawer_max_top)
+#     typed as side-hinged doors (room_wall.enabled)
+# 13: image cells are cut first at an L-shaped outline's corner (cells.outline_step); drawer-typed fronts
+#     above 1.7 m are dropped (reach.drawer_max_top)
 # 14: handles in the mesh stand out from the surface around them, not the fitted plane
-#     (protrusion_from_surface), and a handle has the plane's outline on both long sides (handle_side_cover)
-# (per-view colour registration, register_sigmas_px, is opt-in: off it changes nothing, and the
+#     (handles.protrusion_from_surface), and a handle has the plane's outline on both long sides (handles.side_cover)
+# (per-view colour registration, registration.sigmas_px, is opt-in: off it changes nothing, and the
 # configuration a run uses is part of the cache key)
 HEURISTIC_VERSION = "14"
 # 2: says "sliding" for GT prismatic joints in the part's front plane

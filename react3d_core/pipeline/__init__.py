@@ -8,10 +8,10 @@ Prefect tasks (``tasks/``) wrap the same step functions with caching and the con
 from .convert import OUTPUT_KIND, ProgressFn, StageClock, convert, output_marker
 from .stages import (STEPS, ConfigView, all_stages, closure, key_material, manifest_versions, step_config,
                      step_sections, view)
-from .steps import (LoadedScene, articulate, assemble, evaluate, export, finalize, load, openable_phrases,
-                    pack_masks, perceive, report, segment, split_on_oom)
+from .steps import (LoadedScene, articulate, assemble, check_physics, evaluate, export, finalize, load, openable_phrases,
+                    pack_masks, perceive, record_physics, report, segment, split_on_oom)
 
 __all__ = ["OUTPUT_KIND", "STEPS", "ConfigView", "LoadedScene", "ProgressFn", "StageClock", "all_stages", "articulate",
-           "assemble", "closure", "convert", "evaluate", "export", "finalize", "key_material", "load",
-           "manifest_versions", "openable_phrases", "output_marker", "pack_masks", "perceive", "report", "segment",
+           "assemble", "check_physics", "closure", "convert", "evaluate", "export", "finalize", "key_material", "load",
+           "manifest_versions", "openable_phrases", "output_marker", "pack_masks", "perceive", "record_physics", "report", "segment",
            "split_on_oom", "step_config", "step_sections", "view"]

@@ -59,12 +59,22 @@ class StageClock:
             self.timings[name] = time.perf_counter() - t
 
 
+def _physics(manifest: Path, cfg: PipelineConfig) -> None:
+    """The physics check of the export beside ``manifest``, recorded in it; never fails the conversion."""
+    try:
+        result = steps.check_physics(manifest.parent, cfg.physics)
+    except Exception as exc:  # noqa: BLE001 - reported, not raised: the scene itself is fine
+        steps.record_physics(manifest, None, f"{type(exc).__name__}: {str(exc).strip()[:300]}")
+        return
+    steps.record_physics(manifest, result)
+
+
 def convert(scene_path: str | Path, out_dir: str | Path, config: PipelineConfig | dict[str, Any] | None = None,
             perception: Perception | None = None, progress: ProgressFn | None = None) -> InteractiveScene:
     """Convert the scan at ``scene_path`` into ``out_dir``; returns the written manifest.
 
-    ``perception``: a backend to use (default: the weight-free one the config names; the ``models``
-    backend needs weights and is built by ``tasks.models.make_model_perception``)."""
+    ``perception``: a backend to use (default: the one the config names, built by
+    :func:`react3d_core.perception.make_perception`; ``models`` needs the ``react3d_models`` package)."""
     t_all = time.perf_counter()
     out = check_output_dir(out_dir, (str(scene_path),), kind=OUTPUT_KIND)  # before any stage runs
     cfg = config if isinstance(config, PipelineConfig) else PipelineConfig().with_overrides(config or {})
@@ -101,6 +111,9 @@ def convert(scene_path: str | Path, out_dir: str | Path, config: PipelineConfig 
             done(steps.assemble(loaded, parts, cfg, staging))
         with clock.stage("export", 1, record=bool(formats)) as done:
             done(steps.export(manifest, formats, cfg.export) if formats else None)
+        if formats and cfg.physics.enabled:
+            with clock.stage("physics", 1) as done:
+                done(_physics(manifest, cfg))
         metrics = None
         if loaded.scene.gt_dir is not None:
             t = time.perf_counter()

@@ -20,7 +20,7 @@ from ..stage import StageSpec
 # Stage packages in pipeline order; each declares ``STAGE`` (react3d_core/stage.py).
 STAGE_PACKAGES = ("react3d_core.scene_io", "react3d_core.perception", "react3d_core.fusion", "react3d_core.articulation",
                   "react3d_core.dedup", "react3d_core.cavity", "react3d_core.assembly", "react3d_core.texture",
-                  "react3d_core.export", "react3d_core.viewer")
+                  "react3d_core.export", "react3d_core.physics", "react3d_core.viewer")
 
 # Steps of a conversion and the stages each runs (perception per frame batch, articulation per part).
 STEPS: dict[str, tuple[str, ...]] = {
@@ -29,6 +29,7 @@ STEPS: dict[str, tuple[str, ...]] = {
     "articulation": ("articulation",),
     "assembly": ("dedup", "cavity", "assembly"),
     "export": ("texture", "export"),
+    "physics": ("physics",),
 }
 
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ..config import EvaluationConfig, ExportConfig, FrameSelectionConfig, PerceptionConfig, PipelineConfig
+from ..config import EvaluationConfig, ExportConfig, FrameSelectionConfig, PerceptionConfig, PhysicsConfig, PipelineConfig
 from ..data.frames import Frame, SceneInput
 from ..data.masks import ArticulationPrediction, Mask2D, PackedMasks
 from ..data.mesh import TriMesh, load_mesh
@@ -161,6 +161,29 @@ def export(manifest_path: str | Path, formats: Sequence[str], cfg: ExportConfig)
     from ..export import export_scene
 
     return export_scene(manifest_path, tuple(formats), cfg)
+
+
+def check_physics(out_dir: str | Path, cfg: PhysicsConfig) -> dict[str, Any]:
+    """The physics check of an exported scene (``react3d_core.physics``), as a JSON dict."""
+    from ..physics import check_output
+
+    return check_output(out_dir, cfg).model_dump(mode="json")
+
+
+def record_physics(manifest_path: str | Path, check: dict[str, Any] | None, error: str | None = None) -> None:
+    """Write the full check beside the manifest (``physics_check.json``) and its summary into the manifest's
+    ``physics`` key; ``error``: the check itself could not run (the conversion still succeeds)."""
+    from ..atomic import write_json
+    from ..physics import DEFAULT_JSON, PhysicsCheck
+
+    manifest_path = Path(manifest_path)
+    if check is not None:
+        write_json(manifest_path.parent / DEFAULT_JSON, check)
+        summary = {**PhysicsCheck.model_validate(check).summary(), "file": DEFAULT_JSON}
+    else:
+        summary = {"passed": False, "error": error or "not run"}
+    m = InteractiveScene.load(manifest_path)
+    m.model_copy(update={"physics": summary}).save(manifest_path)
 
 
 def evaluate(manifest_path: str | Path, gt_dir: str | Path, cfg: EvaluationConfig) -> dict[str, Any]:

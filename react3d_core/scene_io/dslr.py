@@ -1,8 +1,11 @@
 """ScanNet++ DSLR layout: COLMAP text model + fisheye images, undistorted and given mesh-rendered depth.
 
+``dslr/colmap/{cameras,images}.txt`` (world-to-camera, qw qx qy qz; OPENCV_FISHEYE or PINHOLE),
+``dslr/resized_images/`` (or ``resized_undistorted_images/``), mesh ``scans/mesh_aligned_0.05.ply``.
 Follows the ScanNet++ toolkit: cv2.fisheye undistortion with balance 0, principal point forced to the
 image centre, same size, poses unchanged; depth rendered from the mesh (near 0.05 m, far 20 m) because
-the DSLR has none. Outputs go to a cache folder (inputs are never modified) and are reused if present.
+the DSLR has none. Outputs go to a cache folder (default ``<scene>/.react3d_cache``; inputs are never
+modified) and are reused if present; frames are selected first, so unselected frames cost nothing.
 """
 
 from __future__ import annotations
@@ -14,9 +17,13 @@ import numpy as np
 
 from ..atomic import atomic_path
 from ..camera import colmap_to_c2w
-from ..data.frames import Frame, ImageRef, Intrinsics
+from ..data.frames import Frame, ImageRef, Intrinsics, SceneInput
 from ..data.mesh import load_mesh
 from ..errors import InputError
+from .checks import checked_mesh, find_gt_dir
+from .layout import Layout, LoadOptions
+
+NAME = "scannetpp_dslr"
 
 NEAR, FAR = 0.05, 20.0
 
@@ -121,3 +128,18 @@ def _write(path: Path, img: np.ndarray) -> None:
     with atomic_path(path) as tmp:
         if not cv2.imwrite(str(tmp), img):
             raise OSError(f"cannot write {path}")
+
+
+def detect(root: Path) -> bool:
+    return (root / "dslr" / "colmap" / "images.txt").is_file()
+
+
+def load(root: Path, options: LoadOptions) -> SceneInput:
+    mesh = checked_mesh(root / "scans" / "mesh_aligned_0.05.ply")
+    cache = Path(options.cache_dir) if options.cache_dir else root / ".react3d_cache"
+    frames = load_dslr_frames(root, cache / "dslr", mesh, lambda fs: options.select(list(fs), mesh))
+    return SceneInput(scene_id=root.name, root=root, mesh_path=mesh, frames=tuple(frames), source_format=NAME,
+                      gt_dir=find_gt_dir(root))
+
+
+LAYOUT = Layout(NAME, "dslr/colmap/images.txt", detect, load, selects_frames=True)

@@ -15,6 +15,7 @@ import numpy as np
 from ..atomic import atomic_path, write_json
 from ..camera import K_SIZE, opencv_to_opengl_c2w
 from ..data.frames import SceneInput
+from . import iphone, nerfstudio, prepared
 from .depth_bin import write_depth_bin
 from .images import read_depth, read_rgb
 
@@ -83,4 +84,5 @@ def write_generic(scene: SceneInput, out: str | Path) -> Path:
     return out
 
 
-WRITERS = {"scannetpp_iphone": write_scannetpp_iphone, "prepared": write_prepared, "generic": write_generic}
+WRITERS = {iphone.NAME: write_scannetpp_iphone, prepared.NAME: write_prepared, nerfstudio.NAME: write_generic}
+"""Writer per layout name (the ScanNet++ DSLR layout is read only: its fisheye images are not re-created)."""

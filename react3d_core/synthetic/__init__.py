@@ -1,7 +1,8 @@
 """Synthetic scenes with exact ground truth, written in the ScanNet++ iPhone layout.
 
-Sources: ``procedural`` (our rooms: kitchens, wardrobes, dressers, room doors), ``scene-synthesizer``
-(its procedural kitchens) and ``urdf`` (any articulated URDF). Same arguments -> same bytes.
+Sources: ``procedural`` (our rooms: kitchens, wardrobes, dressers, room doors, and rooms of free-standing
+furniture and appliances, glass-panel doors and dark fronts), ``scene-synthesizer`` (its procedural
+kitchens) and ``urdf`` (any articulated URDF). Same arguments -> same bytes.
 """
 
 from __future__ import annotations
@@ -10,14 +11,16 @@ from pathlib import Path
 
 import numpy as np
 
+from .depth_effects import DEPTH_DROPOUT
 from .materials import REALISM
-from .procedural import KINDS, SynthLayout, build_room
+from .procedural import ALL_KINDS, KINDS, SynthLayout, build_room
 from .remesh import MESH_KINDS
 from .writer import GENERATOR_VERSION, write_synthetic
 
 STAGE_VERSION = GENERATOR_VERSION
 SOURCES = ("procedural", "scene-synthesizer", "urdf")
-__all__ = ["KINDS", "MESH_KINDS", "REALISM", "SOURCES", "STAGE_VERSION", "build_room", "demo_scene", "generate_scene"]
+__all__ = ["ALL_KINDS", "DEPTH_DROPOUT", "KINDS", "MESH_KINDS", "REALISM", "SOURCES", "STAGE_VERSION", "build_room", "demo_scene",
+           "generate_scene"]
 
 
 def _room_depths(layout: SynthLayout) -> list[float]:
@@ -29,7 +32,7 @@ def _room_depths(layout: SynthLayout) -> list[float]:
 def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 0, n_frames: int = 60,
                    urdf_path: str | Path | None = None, kind: str | None = None, edge: float | None = None,
                    mesh: str = "clean", realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0),
-                   up: str = "z", scale: float = 1.0) -> Path:
+                   up: str = "z", scale: float = 1.0, depth_dropout: str = "none") -> Path:
     """Build, render and write one synthetic scene; returns ``out_dir``.
 
     ``kind`` picks the procedural room type (default by seed), ``edge`` the triangle size of the
@@ -37,7 +40,9 @@ def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 
     ``mesh`` (clean | laser | tsdf) re-makes the written scan mesh like a real scan, ``realism``
     (photo | plain) picks the image renderer, ``misregister`` shifts colour against depth by (dx, dy)
     pixels (see :func:`.writer.write_synthetic`). ``up`` / ``scale`` (urdf only): the asset's up axis
-    and unit scale (:func:`.from_urdf.build_from_urdf`).
+    and unit scale (:func:`.from_urdf.build_from_urdf`). ``depth_dropout`` (none | dark): drop depth on
+    dark and glossy surfaces like a ToF sensor, in the depth frames and the laser / TSDF mesh
+    (:mod:`.depth_effects`).
     """
     if source != "urdf" and (up != "z" or scale != 1.0):
         raise ValueError("up/scale apply to source='urdf' only")
@@ -57,7 +62,7 @@ def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 
     else:
         raise ValueError(f"unknown source {source!r}; choose from {', '.join(SOURCES)}")
     return write_synthetic(layout, out_dir, n_frames, seed, source, room_depths=_room_depths(layout), mesh=mesh,
-                           realism=realism, misregister=misregister)
+                           realism=realism, misregister=misregister, depth_dropout=depth_dropout)
 
 
 def demo_scene(out_dir: str | Path) -> Path:

@@ -54,6 +54,58 @@ def box_mesh(lo: np.ndarray, hi: np.ndarray, edge: float, skip: tuple[tuple[int,
     return concat_meshes(pieces)
 
 
+def _orient(p: np.ndarray, tris: np.ndarray, want: np.ndarray) -> np.ndarray:
+    """``tris`` with each triangle's winding flipped where its normal points against ``want`` (per face)."""
+    n = np.cross(p[tris[:, 1]] - p[tris[:, 0]], p[tris[:, 2]] - p[tris[:, 0]])
+    flip = (n * want).sum(1) < 0
+    out = tris.copy()
+    out[flip] = tris[flip][:, ::-1]
+    return out
+
+
+def cylinder_mesh(cx: float, cz: float, y0: float, y1: float, r_out: float, edge: float,
+                  r_in: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """A disc (``r_in`` = 0) or ring of radius ``r_out`` whose axis runs along y from ``y0`` to ``y1``
+    (a round door or window facing -y in a wall frame), centred at (cx, cz); faces ~``edge``, outward."""
+    n_t = max(12, int(np.ceil(2 * np.pi * r_out / edge)))
+    th = np.linspace(0.0, 2 * np.pi, n_t, endpoint=False)
+    ring = np.stack([np.cos(th), np.sin(th)], 1)
+    n_r = max(1, int(np.ceil((r_out - r_in) / edge)))
+    radii = np.linspace(r_in, r_out, n_r + 1)
+    pieces = []
+    j = np.arange(n_t)
+    jn = (j + 1) % n_t
+
+    def strip(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+        """Quads between two rings of ``n_t`` vertices (indices a, b)."""
+        return np.concatenate([np.stack([a[j], a[jn], b[jn]], 1), np.stack([a[j], b[jn], b[j]], 1)])
+
+    for y, sign in ((y0, -1.0), (y1, 1.0)):  # caps
+        rs = radii[1:] if r_in == 0.0 else radii
+        pts = [np.array([[cx, y, cz]])] if r_in == 0.0 else []
+        pts += [np.c_[cx + r * ring[:, 0], np.full(n_t, y), cz + r * ring[:, 1]] for r in rs]
+        p = np.concatenate(pts)
+        off = 1 if r_in == 0.0 else 0
+        tris = []
+        if r_in == 0.0:
+            tris.append(np.stack([np.zeros(n_t, int), 1 + j, 1 + jn], 1))
+        for k in range(len(rs) - 1):
+            tris.append(strip(off + k * n_t + np.arange(n_t), off + (k + 1) * n_t + np.arange(n_t)))
+        t = np.concatenate(tris)
+        pieces.append((p, _orient(p, t, np.array([0.0, sign, 0.0])[None])))
+    n_y = max(1, int(np.ceil(abs(y1 - y0) / edge)))
+    for r, out in ((r_out, 1.0), (r_in, -1.0)):  # outer and inner walls
+        if r <= 0.0:
+            continue
+        ys = np.linspace(y0, y1, n_y + 1)
+        p = np.concatenate([np.c_[cx + r * ring[:, 0], np.full(n_t, y), cz + r * ring[:, 1]] for y in ys])
+        t = np.concatenate([strip(k * n_t + np.arange(n_t), (k + 1) * n_t + np.arange(n_t)) for k in range(n_y)])
+        c = p[t].mean(1)
+        want = out * np.c_[c[:, 0] - cx, np.zeros(len(c)), c[:, 2] - cz]
+        pieces.append((p, _orient(p, t, want)))
+    return concat_meshes(pieces)
+
+
 @dataclass
 class MeshBuilder:
     """Collects pieces (vertices, faces, colour) under part keys and merges them in insertion order."""
@@ -95,6 +147,12 @@ class MeshBuilder:
     def add_box(self, lo, hi, color, key: str | None = None, transform: np.ndarray | None = None,  # noqa: ANN001
                 skip: tuple[tuple[int, int], ...] = (), material: int = MATTE) -> None:
         v, f = box_mesh(np.asarray(lo, float), np.asarray(hi, float), self.edge, skip)
+        self.add(v, f, color, key, transform, material=material)
+
+    def add_cylinder(self, cx: float, cz: float, y0: float, y1: float, r_out: float, color, key: str | None = None,  # noqa: ANN001
+                     transform: np.ndarray | None = None, r_in: float = 0.0, material: int = MATTE) -> None:
+        """A disc or ring along y (see :func:`cylinder_mesh`)."""
+        v, f = cylinder_mesh(cx, cz, y0, y1, r_out, self.edge, r_in)
         self.add(v, f, color, key, transform, material=material)
 
     def build(self) -> tuple[TriMesh, np.ndarray, dict[str, int]]:

@@ -13,7 +13,7 @@ capture of the closed scene never sees (drawer boxes, appliance insides) is cull
 centimetres): the asset is rotated so that axis becomes the scene's +z and scaled, joints with it.
 Where the joints say otherwise (drawers that would slide vertically, hinges lying along another axis)
 a warning goes to the log and to ``synth_meta.json`` (``up_warnings``): a wrong up axis used to give a
-cabinet lying on its side without a word (issue 16).
+cabinet lying on its side without a word.
 """
 
 from __future__ import annotations

@@ -28,8 +28,8 @@ from functools import lru_cache
 import cv2
 import numpy as np
 
-MATTE, WOOD, GLOSSY, METAL, STONE = 0, 1, 2, 3, 4
-MATERIAL_NAMES = ("matte", "wood", "glossy", "metal", "stone")
+MATTE, WOOD, GLOSSY, METAL, STONE, GLASS = 0, 1, 2, 3, 4, 5
+MATERIAL_NAMES = ("matte", "wood", "glossy", "metal", "stone", "glass")
 REALISM = ("plain", "photo")
 
 # per material: broad lobe (ks, shininess), sharp lobe (ks, shininess), Fresnel f0, room-reflection strength
@@ -39,7 +39,21 @@ _SPEC = np.array([
     [0.20, 40.0, 0.90, 600.0, 0.05, 0.90],  # glossy lacquer / laminate
     [0.45, 25.0, 0.80, 200.0, 0.50, 0.70],  # metal handles
     [0.08, 30.0, 0.30, 300.0, 0.04, 0.40],  # polished stone
+    [0.00, 1.0, 1.00, 900.0, 0.06, 1.00],   # glass (only its reflection is drawn: see GlassLayer)
 ], np.float32)
+
+
+@dataclass(frozen=True)
+class GlassLayer:
+    """Glass panes in front of the rendered surface: per pixel whether the first hit is glass, and that
+    hit's normal and point (H, W, 3) and the pane's tint (H, W, 3 in 0..1). The image is shaded from
+    what lies behind the glass; the pane lets ``tint`` x (1 - Fresnel) of it through and adds a
+    Fresnel-weighted reflection of the room and sharp highlights of the lights (no refraction)."""
+
+    mask: np.ndarray
+    normal: np.ndarray
+    point: np.ndarray
+    tint: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -189,14 +203,38 @@ def _vignette(H: int, W: int) -> np.ndarray:
     return (1.0 - 0.3 * r2n).astype(np.float32)
 
 
+def _through_glass(img: np.ndarray, glass: GlassLayer, d: np.ndarray, settings: PhotoSettings) -> np.ndarray:
+    """``img`` (H, W, 3, linear, before exposure) seen through the panes of ``glass``; ``d`` the
+    channel-first unit view rays."""
+    g = glass.mask
+    dg = d[:, g]
+    n = glass.normal[g].astype(np.float32).T
+    n *= np.where(_dot(n, dg) > 0, np.float32(-1.0), np.float32(1.0))
+    ndv = np.clip(-_dot(n, dg), 0.0, 1.0)
+    f0, shine, refl = _SPEC[GLASS, 4], _SPEC[GLASS, 3], _SPEC[GLASS, 5]
+    fres = f0 + (1.0 - f0) * (1.0 - ndv) ** 5
+    rz = dg[2] + 2.0 * ndv * n[2]
+    add = refl * fres * (0.45 + 0.35 * rz)  # the room reflected: brighter towards the ceiling lights
+    p = glass.point[g].astype(np.float32).T
+    for lx, ly, lz, power in settings.lights:
+        L = np.array([lx, ly, lz], np.float32)[:, None] - p
+        h = L / np.sqrt(_dot(L, L)) - dg
+        h /= np.sqrt(_dot(h, h)) + 1e-9
+        add += power * 0.8 * np.clip(_dot(n, h), 0.0, 1.0) ** shine
+    out = img.copy()
+    out[g] = img[g] * (glass.tint[g] * (1.0 - fres)[:, None]) + add[:, None]
+    return out
+
+
 def render_photo(hit: dict[str, np.ndarray], faces: np.ndarray, colors: np.ndarray, face_mat: np.ndarray,
                  settings: PhotoSettings, frame_rng: np.random.Generator, noise_rng: np.random.Generator,
-                 face_colors: np.ndarray | None = None) -> np.ndarray:
+                 face_colors: np.ndarray | None = None, glass: GlassLayer | None = None) -> np.ndarray:
     """Photo-like uint8 RGB image of one ray-cast frame (``hit`` from :meth:`RayCaster.cast`).
 
     Albedo is ``face_colors`` (per face) when given, else the vertex colours. ``noise_rng`` draws
     exactly what the plain renderer draws (one standard normal per channel), so the scene's depth
-    noise, drawn after it from the same generator, is the same in both modes.
+    noise, drawn after it from the same generator, is the same in both modes. ``glass``: panes in
+    front of ``hit`` (which is then the surface behind them), see :class:`GlassLayer`.
     """
     face = hit["face"]
     ok = face >= 0
@@ -238,6 +276,8 @@ def render_photo(hit: dict[str, np.ndarray], faces: np.ndarray, colors: np.ndarr
     spec += refl * fres * (0.35 + 0.3 * rz)
     occl = 1.0 - 0.85 * ao
     img = (albedo * (diffuse * occl)[..., None] + (spec * occl)[..., None]) * ok[..., None]
+    if glass is not None and glass.mask.any():
+        img = _through_glass(img, glass, d, settings)
     gain = np.float32(1.5 * np.exp(frame_rng.normal(0.0, settings.exposure_sigma)))
     wb = np.exp(frame_rng.normal(0.0, 0.03, 3)).astype(np.float32)
     img = img.astype(np.float32) * (gain * wb)[None, None] * _vignette(H, W)[..., None]

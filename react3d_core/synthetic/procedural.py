@@ -17,8 +17,9 @@ from .furniture import PALETTES, Builder, PartSpec, WallFrame
 from .materials import STONE, WOOD
 
 KINDS = ("kitchen", "wardrobe", "dresser", "room_door", "mixed")  # the default kind is KINDS[seed % 5]
-# kinds only built when asked for (so the seed -> kind mapping of existing scenes stays as it was)
-EXTRA_KINDS = ("sliding", "large_kitchen")
+# kinds only built when asked for (so the seed -> kind mapping of existing scenes stays as it was);
+# the last four are rooms of free-standing furniture and appliances (rooms.py)
+EXTRA_KINDS = ("sliding", "large_kitchen", "furniture", "appliances", "glass", "dark")
 ALL_KINDS = KINDS + EXTRA_KINDS
 WALL_T = 0.12
 
@@ -52,6 +53,7 @@ class SynthLayout:
     observed_only: bool = False
     face_materials: np.ndarray | None = None  # per face, see materials.py (None: all matte)
     face_colors: np.ndarray | None = None     # per face albedo for the photo renderer (None: vertex colours)
+    gt_boxes: bool = False  # write each movable part's true box and scan coverage in the GT (writer.py)
 
 
 def wall_frames(W: float, L: float) -> list[tuple[WallFrame, float]]:
@@ -171,7 +173,7 @@ def _dresser(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
 
 def _sliding(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun], H: float) -> None:
     """A low sideboard / TV cabinet with a pair of sliding doors (above a drawer row half the time) and a
-    sliding-door wardrobe beside it: sliding doors with GT joints in the front plane (issue 16)."""
+    sliding-door wardrobe beside it: sliding doors with GT joints in the front plane."""
     pal = PALETTES[int(rng.integers(len(PALETTES)))]
     handles = bool(rng.random() < 0.8)
     D, Hs, w = float(rng.uniform(0.4, 0.48)), float(rng.uniform(0.55, 0.8)), float(rng.uniform(1.2, 1.6))
@@ -190,7 +192,7 @@ def _sliding(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator,
 def _long_kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Generator, runs: list[ViewRun],
                   H: float, x_min: float = 0.0) -> None:
     """A full wall of base units (up to 8) with wall cabinets over all of them: two such walls (an L)
-    hold 32-52 openable parts (42 on average over 30 seeds), like the large kitchens of real rooms (issue 16)."""
+    hold 32-52 openable parts (42 on average over 30 seeds), like the large kitchens of real rooms."""
     _kitchen(b, fr, length, rng, runs, H, max_units=8, wall_p=1.0, x_min=x_min)
 
 
@@ -202,10 +204,14 @@ def _corner_kitchen(b: Builder, fr: WallFrame, length: float, rng: np.random.Gen
 
 def build_room(seed: int, kind: str | None = None, edge: float = 0.03) -> SynthLayout:
     """A seeded room of the given kind (default: chosen by seed)."""
-    rng = np.random.default_rng(seed)
     kind = kind or KINDS[seed % len(KINDS)]
     if kind not in ALL_KINDS:
         raise ValueError(f"unknown scene kind {kind!r}; choose from {', '.join(ALL_KINDS)}")
+    if kind in EXTRA_KINDS[2:]:
+        from .rooms import build_free_room
+
+        return build_free_room(seed, kind, edge)
+    rng = np.random.default_rng(seed)
     W, L, H = float(rng.uniform(3.4, 4.6)), float(rng.uniform(3.8, 5.2)), float(rng.uniform(2.5, 2.8))
     m = MeshBuilder(edge=edge, seed=seed)
     b = Builder(m, rng)

@@ -2,7 +2,7 @@
 
 A generated scene's own mesh is perfect: every front is a separate slab with a 4 mm gap around it and
 handles are exact boxes. Real scan meshes are not, and perception tuned on perfect meshes fails on
-them (issue 15). So the written mesh can be re-made the way real scans are:
+them. So the written mesh can be re-made the way real scans are:
 
 - ``tsdf``: the scene's own noisy depth frames (256x192, after :func:`.render.sensor_depth`, as
   uint16 mm like ``depth.bin``) and colour frames (the written RGB, area-resized to the depth size)
@@ -175,12 +175,17 @@ def transfer_labels(src: TriMesh, src_face_label: np.ndarray, dst: TriMesh, radi
     return Transfer(lab.astype(np.int64), flab.astype(np.int64), dist, np.clip(np.round(col), 0, 255).astype(np.uint8))
 
 
-def transfer_parts(parts: list[GTPart], tr: Transfer) -> tuple[list[GTPart], list[int]]:
-    """GT parts on the new mesh (same part ids, joints and bases); returns them and the dropped ids."""
+def transfer_parts(parts: list[GTPart], tr: Transfer, keep_empty_movable: bool = False) -> tuple[list[GTPart], list[int]]:
+    """GT parts on the new mesh (same part ids, joints and bases); returns them and the dropped ids.
+    ``keep_empty_movable``: a movable part left without vertices or faces stays (empty; its GT box
+    scores it), as a front the depth sensor missed still exists."""
     out, dropped = [], []
     for p in parts:
         vert = np.flatnonzero(tr.vertex_label == p.part_id)
         tri = np.flatnonzero(tr.face_label == p.part_id)
+        if keep_empty_movable and p.movable and (len(vert) == 0 or len(tri) == 0):
+            out.append(GTPart(p.part_id, p.label, tri, vert, p.articulation, list(p.base)))
+            continue
         if len(vert) == 0 or len(tri) == 0:
             dropped.append(p.part_id)
             continue

@@ -11,6 +11,7 @@ The folder appears whole or not at all (built in a temporary sibling and renamed
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import cv2
@@ -18,10 +19,13 @@ import numpy as np
 
 from ..atomic import atomic_dir, write_json
 from ..data.mesh import TriMesh, save_mesh
+from ..data.parts import OBB
 from ..ground_truth.articulate3d import GroundTruth, GTPart, write_articulate3d
+from ..raster import Rasterizer
 from ..scene_io.depth_bin import write_depth_bin
 from .camera_path import camera_walk
-from .materials import REALISM, PhotoSettings, render_photo, scene_lights
+from .depth_effects import DEPTH_DROPOUT, dark_dropout, glass_returns, is_glass, linear_albedo
+from .materials import GLASS, REALISM, GlassLayer, PhotoSettings, render_photo, scene_lights
 from .observed import keep_faces, observed_faces
 from .procedural import SynthLayout
 from .remesh import (LASER_DECIMATION, LASER_VOXEL, MESH_KINDS, TRANSFER_RADIUS, TSDF_VOXEL, TsdfFuser, decimate,
@@ -33,8 +37,11 @@ from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, s
 GENERATOR_VERSION = "4"
 
 
-def _gt_parts(layout: SynthLayout) -> tuple[list[GTPart], np.ndarray, list[dict]]:
-    """GT parts (movable, then handles, then static carcasses), the face -> partId table and meta rows."""
+def _gt_parts(layout: SynthLayout, keep: np.ndarray | None = None) -> tuple[list[GTPart], np.ndarray, list[dict]]:
+    """GT parts (movable, then handles, then static carcasses), the face -> partId table and meta rows.
+
+    ``keep`` (face ids of ``layout.mesh``): the GT indexes the sub-mesh of these faces (the written
+    scan without its glass panes); the face -> partId table stays that of the whole mesh."""
     mesh, keys = layout.mesh, layout.face_keys
     key_pid: dict[str, int] = {}
     order: list[tuple[str, str, object]] = []
@@ -52,9 +59,13 @@ def _gt_parts(layout: SynthLayout) -> tuple[list[GTPart], np.ndarray, list[dict]
         if k in key_pid:
             lut[kid] = key_pid[k]
     face_pid = lut[keys]  # keys == -1 index the trailing -1 entry
+    on_mesh = face_pid
+    if keep is not None:
+        mesh, _ = mesh.submesh(keep)
+        on_mesh = face_pid[keep]
     parts, meta = [], []
     for pid, (k, label, spec) in enumerate(order):
-        tri = np.flatnonzero(face_pid == pid)
+        tri = np.flatnonzero(on_mesh == pid)
         vert = np.unique(mesh.faces[tri].ravel())
         art = spec.articulation if spec is not None else None  # type: ignore[union-attr]
         base = [key_pid[spec.parent_key]] if spec is not None and spec.parent_key in key_pid else []  # type: ignore[union-attr]
@@ -75,15 +86,16 @@ def _ray_norm(K: np.ndarray, width: int, height: int) -> np.ndarray:
 
 
 def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: list[GTPart], face_pid: np.ndarray,
-                 meta: list[dict]) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
-    """The fused scan mesh, the GT moved onto it, the meta rows of the parts kept and mesh statistics."""
+                 meta: list[dict], keep_empty: bool = False) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
+    """The fused scan mesh, the GT moved onto it, the meta rows of the parts kept and mesh statistics.
+    ``keep_empty``: movable parts left without scan surface stay in the GT (they carry their box)."""
     new = fuser.mesh()
     if kind == "laser":
         new = decimate(new, LASER_DECIMATION)
     tr = transfer_labels(layout.mesh, face_pid, new)
     if kind == "laser":  # a laser scan is coloured from registered photos: the clean colour at the surface
         new = TriMesh(new.vertices, new.faces, tr.colors)
-    parts, dropped = transfer_parts(gt_parts, tr)
+    parts, dropped = transfer_parts(gt_parts, tr, keep_empty_movable=keep_empty)
     n_faces = {p.part_id: len(p.tri_indices) for p in parts}
     rows = []
     for r in meta:
@@ -102,15 +114,108 @@ def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: lis
     return new, parts, rows, stats
 
 
+def part_box(points: np.ndarray) -> OBB:
+    """Upright box of a part's points (z up; the horizontal sides from the minimum-area rectangle of
+    their footprint), sides sorted longest first: the true box of a front, a lid or a porthole door."""
+    import cv2
+
+    p = np.asarray(points, float)
+    (cx, cy), (w, h), ang = cv2.minAreaRect(p[:, :2].astype(np.float32))
+    a = np.radians(ang)
+    u, v = np.array([np.cos(a), np.sin(a), 0.0]), np.array([-np.sin(a), np.cos(a), 0.0])
+    z0, z1 = float(p[:, 2].min()), float(p[:, 2].max())
+    # refit the centre and extents in float64 along the rectangle's sides
+    pu, pv = p @ u, p @ v
+    axes = [u, v, np.array([0.0, 0.0, 1.0])]
+    lo = np.array([pu.min(), pv.min(), z0])
+    hi = np.array([pu.max(), pv.max(), z1])
+    ext = hi - lo
+    centre = np.stack(axes, 1) @ ((lo + hi) / 2)
+    order = np.argsort(-ext, kind="stable")
+    R = np.stack([axes[k] for k in order], 1)
+    if np.linalg.det(R) < 0:
+        R[:, 2] *= -1
+    return OBB(center=tuple(centre), axes=tuple(map(tuple, R.T)), extents=tuple(ext[order]))
+
+
+def _face_samples(mesh: TriMesh, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Four points per face (centroid and halfway from it to each corner) and each point's area share."""
+    tri = mesh.vertices[mesh.faces[faces]]
+    c = tri.mean(1, keepdims=True)
+    pts = np.concatenate([c, 0.5 * (c + tri)], 1).reshape(-1, 3)
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    return pts, np.repeat(area / 4.0, 4)
+
+
+def _boxes_and_coverage(layout: SynthLayout, face_pid: np.ndarray, parts: list[GTPart], scan: TriMesh | None,
+                        seen: np.ndarray, glass: np.ndarray) -> dict[int, tuple[OBB, float]]:
+    """Per movable GT part: its true box (its faces and its children's in the generated mesh) and the
+    share of its observed opaque surface (faces any frame saw, glass left out; all its opaque faces if
+    no frame saw it) that lies within the transfer radius of the scan mesh (``scan`` None: the written
+    mesh is the generated one, share 1)."""
+    mesh = layout.mesh
+    out: dict[int, tuple[OBB, float]] = {}
+    dist = Rasterizer(scan) if scan is not None and scan.n_faces else None
+    for p in parts:
+        if p.articulation is None:
+            continue
+        kids = [q.part_id for q in parts if q.articulation is None and q.label.startswith(p.label + ".")]
+        own = np.isin(face_pid, [p.part_id] + kids)
+        box = part_box(mesh.vertices[np.unique(mesh.faces[own].ravel())])
+        obs = np.flatnonzero(own & seen & ~glass)
+        if not len(obs):  # no frame saw it: its whole opaque surface
+            obs = np.flatnonzero(own & ~glass)
+        pts, w = _face_samples(mesh, obs)
+        if scan is None:
+            cov = 1.0
+        elif dist is None:
+            cov = 0.0
+        else:
+            cov = float(w[dist.distance(pts.astype(np.float32)) <= TRANSFER_RADIUS].sum() / w.sum())
+        out[p.part_id] = (box, cov)
+    return out
+
+
+@dataclass
+class _SeeThrough:
+    """Ray casts past glass panes: the scene without its glass faces, ids mapped back to the whole mesh."""
+
+    caster: RayCaster
+    ids: np.ndarray  # opaque-mesh face -> whole-mesh face
+
+    @classmethod
+    def of(cls, mesh: TriMesh, glass: np.ndarray) -> "_SeeThrough":
+        keep = np.flatnonzero(~glass)
+        sub, _ = mesh.submesh(keep)
+        return cls(RayCaster(sub), keep)
+
+    def behind(self, front: dict[str, np.ndarray], glass_px: np.ndarray, K: np.ndarray, c2w: np.ndarray,
+               width: int, height: int) -> dict[str, np.ndarray]:
+        """``front`` where no glass is hit, else the first opaque surface behind the pane."""
+        back = self.caster.cast(K, c2w, width, height)
+        back["face"] = np.where(back["face"] >= 0, self.ids[np.maximum(back["face"], 0)], -1)
+        out = {}
+        for k, v in front.items():
+            sel = glass_px if v.ndim == 2 else glass_px[..., None]
+            out[k] = np.where(sel, back[k], v)
+        return out
+
+
 def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, seed: int, source: str,
                     scene_id: str | None = None, room_depths: list[float] | None = None, mesh: str = "clean",
-                    realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0)) -> Path:
+                    realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0),
+                    depth_dropout: str = "none") -> Path:
     """Render ``n_frames`` views of ``layout`` and write the scene folder; returns ``out_dir``.
 
     ``mesh``: the written scan mesh, ``clean`` (the generated geometry), ``laser`` or ``tsdf`` (re-made
     like a real scan, GT transferred; see :mod:`.remesh`). ``realism``: ``photo`` (materials, lights,
     exposure, blur; :mod:`.materials`) or ``plain`` (flat shading, the generator-version-2 images).
     ``misregister``: colour shifted by (dx, dy) RGB pixels against depth and poses (photo only).
+    ``depth_dropout``: ``dark`` drops depth on dark and glossy surfaces like a ToF sensor, in the depth
+    frames and in the range images a laser / TSDF mesh is fused from (:mod:`.depth_effects`).
+    Glass faces (material ``GLASS``) are seen through in colour and depth and left out of a clean
+    written mesh. Scenes with glass, depth dropout or ``layout.gt_boxes`` carry each movable part's
+    true box and scan coverage in the GT (parts without scan surface are kept).
     """
     out_dir = Path(out_dir)
     if n_frames < 1:
@@ -119,6 +224,8 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
         raise ValueError(f"unknown mesh {mesh!r}; choose from {', '.join(MESH_KINDS)}")
     if realism not in REALISM:
         raise ValueError(f"unknown realism {realism!r}; choose from {', '.join(REALISM)}")
+    if depth_dropout not in DEPTH_DROPOUT:
+        raise ValueError(f"unknown depth_dropout {depth_dropout!r}; choose from {', '.join(DEPTH_DROPOUT)}")
     misregister = (float(misregister[0]), float(misregister[1]))
     if realism == "plain" and misregister != (0.0, 0.0):
         raise ValueError("misregister needs realism='photo'")
@@ -134,8 +241,15 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
         dense = camera_walk(layout.runs, max(3 * n_frames, 240), room_depths, np.random.default_rng(seed + 7_777))
         layout = keep_faces(layout, observed_faces(caster, dense + poses, K))
         caster = RayCaster(layout.mesh)
-    gt_parts, face_pid, meta = _gt_parts(layout)
     face_mat = layout.face_materials if layout.face_materials is not None else np.zeros(layout.mesh.n_faces, np.uint8)
+    glass = face_mat == GLASS
+    see = _SeeThrough.of(layout.mesh, glass) if glass.any() else None
+    keep = np.flatnonzero(~glass) if see is not None and mesh == "clean" else None
+    gt_parts, face_pid, meta = _gt_parts(layout, keep)
+    with_boxes = see is not None or depth_dropout != "none" or layout.gt_boxes
+    seen = np.zeros(layout.mesh.n_faces, bool)
+    tint = (layout.face_colors if layout.face_colors is not None else np.full((layout.mesh.n_faces, 3), 255, np.uint8))
+    albedo = linear_albedo(tint) if depth_dropout == "dark" else None
     photo = PhotoSettings(scene_lights(layout.room), misregister=misregister)
     fuser = {"clean": None, "laser": TsdfFuser(LASER_VOXEL, color=False, depth_scale=5000.0),
              "tsdf": TsdfFuser(TSDF_VOXEL, color=True)}[mesh]
@@ -147,26 +261,57 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
         for i, c2w in enumerate(poses):
             fid = f"frame_{i:06d}"
             hit = caster.cast(K_rgb, c2w, *RGB_SIZE)
+            seen[hit["face"][hit["face"] >= 0]] = True
+            # glass: shaded and ranged from what lies behind it; its own generators keep the others' draws
+            shade, layer, z = hit, None, hit["depth"]
+            fx_rng = np.random.default_rng([seed, i, 0x6A55]) if see is not None or albedo is not None else None
+            if see is not None:
+                gpx = is_glass(hit["face"], face_mat)
+                shade = see.behind(hit, gpx, K_rgb, c2w, *RGB_SIZE)
+                layer = GlassLayer(gpx, hit["normal"], hit["point"], tint[np.maximum(hit["face"], 0)].astype(np.float32) / 255.0)
+                z = np.where(gpx & ~glass_returns(hit, gpx, fx_rng), shade["depth"], hit["depth"])
             if realism == "photo":  # its own per-frame generator: depth noise below stays that of 'plain'
-                rgb = render_photo(hit, layout.mesh.faces, layout.mesh.colors, face_mat, photo,
-                                   np.random.default_rng([seed, i, 0x5EED]), rng, layout.face_colors)
+                rgb = render_photo(shade, layout.mesh.faces, layout.mesh.colors, face_mat, photo,
+                                   np.random.default_rng([seed, i, 0x5EED]), rng, layout.face_colors, glass=layer)
             else:
-                rgb = caster.rgb(hit, rng)
+                rgb = caster.rgb(shade, rng)
+                if layer is not None:
+                    rgb = np.where(layer.mask[..., None], rgb * layer.tint, rgb).astype(np.uint8)
             if mesh == "laser":
-                fuser.add(laser_depth(hit["depth"], ray_norm, np.random.default_rng([seed, i, 0x1A5E])), K_rgb, c2w)
+                if albedo is not None:
+                    z = np.where(dark_dropout(shade, albedo, face_mat, fx_rng), np.inf, z)
+                fuser.add(laser_depth(z, ray_norm, np.random.default_rng([seed, i, 0x1A5E])), K_rgb, c2w)
             cv2.imwrite(str(tmp / "iphone" / "rgb" / f"{fid}.jpg"), cv2.cvtColor(rgb, cv2.COLOR_RGB2BGR),
                         [cv2.IMWRITE_JPEG_QUALITY, 92])
             face = hit["face"]
             pid = np.where(face >= 0, face_pid[np.maximum(face, 0)] + 1, 0)
             cv2.imwrite(str(tmp / "iphone" / "gt_part_ids" / f"{fid}.png"), pid.astype(np.uint16))
             dhit = caster.cast(K_d, c2w, *DEPTH_SIZE)
-            depths.append(sensor_depth(dhit["depth"], rng))
+            zd, dshade = dhit["depth"], dhit
+            if see is not None:
+                gpx = is_glass(dhit["face"], face_mat)
+                dshade = see.behind(dhit, gpx, K_d, c2w, *DEPTH_SIZE)
+                zd = np.where(gpx & ~glass_returns(dhit, gpx, fx_rng), dshade["depth"], dhit["depth"])
+            depths.append(sensor_depth(zd, rng))
+            if albedo is not None:
+                depths[-1][dark_dropout(dshade, albedo, face_mat, fx_rng)] = 0.0
             if mesh == "tsdf":
                 fuser.add(depths[-1], K_d, c2w, rgb)
             pose_json[fid] = {"intrinsic": K.tolist(), "aligned_pose": c2w.tolist(), "timestamp": round(i / 10.0, 3)}
         scan, mesh_stats = layout.mesh, {"kind": "clean"}
+        if keep is not None:
+            scan, _ = layout.mesh.submesh(keep)
+            mesh_stats = {"kind": "clean", "glass_faces_left_out": int(glass.sum())}
         if fuser is not None:
-            scan, gt_parts, meta, mesh_stats = _remeshed_gt(layout, fuser, mesh, gt_parts, face_pid, meta)
+            scan, gt_parts, meta, mesh_stats = _remeshed_gt(layout, fuser, mesh, gt_parts, face_pid, meta, keep_empty=with_boxes)
+        if with_boxes:
+            boxes = _boxes_and_coverage(layout, face_pid, gt_parts, scan if fuser is not None else None, seen, glass)
+            for p in gt_parts:
+                if p.part_id in boxes:
+                    p.obb, p.coverage = boxes[p.part_id]
+            for r in meta:
+                if r["part_id"] in boxes:
+                    r["scan_coverage"] = round(boxes[r["part_id"]][1], 4)
         save_mesh(tmp / "scans" / "mesh_aligned_0.05.ply", scan)
         write_depth_bin(tmp / "iphone" / "depth.bin", depths, "per_frame")
         write_json(tmp / "iphone" / "pose_intrinsic_imu.json", pose_json)
@@ -175,5 +320,6 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
             "generator_version": GENERATOR_VERSION, "source": source, "seed": seed, "kind": layout.kind,
             "scene_id": scene_id, "n_frames": len(poses), "room": list(layout.room),
             "faces": scan.n_faces, "vertices": scan.n_vertices, "parts": meta, "mesh": mesh_stats,
-            "realism": realism, "misregister_px": list(misregister), **layout.extra})
+            "realism": realism, "misregister_px": list(misregister),
+            **({"depth_dropout": depth_dropout} if depth_dropout != "none" else {}), **layout.extra})
     return out_dir

@@ -9,7 +9,7 @@ from .atlas import ATLAS_FILL, cell_atlas, texture_side, xatlas_atlas
 from .bake import TexturedMesh, bake_texture, fill_gutters, rasterize_uv, sample_bilinear, vertex_color_error
 from .writers import write_glb, write_obj_folder
 
-STAGE_VERSION = "2"  # 2: texture encoder options (png level, jpg) (issue #18)
+STAGE_VERSION = "2"  # 2: texture encoder options (png level, jpg)
 STAGE = StageSpec("texture", __name__, STAGE_VERSION, sections=("export",), upstream=("assembly",))
 
 __all__ = [

@@ -1,8 +1,10 @@
-"""Looking at a converted scene: a self-contained HTML viewer/report with a slider per joint."""
+"""Looking at a converted scene: the self-contained viewer page with a slider per joint (``page``), and
+``report.html``, that page with the parts, metrics and timings (``report``)."""
 
 from ..stage import StageSpec
-from .html import build_viewer_html, write_report
+from .page import build_viewer_html
 from .payload import scene_payload
+from .report import write_report
 
 STAGE_VERSION = "1"
 STAGE = StageSpec("viewer", __name__, STAGE_VERSION, sections=(), upstream=("export",))

@@ -1,4 +1,4 @@
-"""Drawer travel bounded by the furniture's own depth when nothing is seen behind it (issue 16).
+"""Drawer travel bounded by the furniture's own depth when nothing is seen behind it.
 
 A free-standing chest in a room, as a capture of the closed chest leaves it: top and side boards are
 observed, its back and insides never are (culled), so a ray into the cavity flies to the room wall 2 m

@@ -1,4 +1,4 @@
-"""Sliding doors (issue 16): the refinement keeps an in-plane axis when the predictor says 'sliding',
+"""Sliding doors: the refinement keeps an in-plane axis when the predictor says 'sliding',
 assembly gives them a travel along their own width, and the heuristic's two-track rule finds them."""
 
 from __future__ import annotations
@@ -9,9 +9,10 @@ import pytest
 from react3d_core.articulation import PartFit, fit_part, refine_articulation
 from react3d_core.articulation.refine import refine_sliding
 from react3d_core.assembly import sliding_limits
+from react3d_core.config.heuristic import SlidingConfig
 from react3d_core.data.parts import Articulation
 from react3d_core.perception.heuristic.fronts import Front
-from react3d_core.perception.heuristic.sliding import SlidingRules, mark_sliding, sliding_partner
+from react3d_core.perception.heuristic.sliding import mark_sliding, sliding_partner
 
 
 
@@ -66,7 +67,7 @@ def test_two_track_fronts_are_sliding_doors() -> None:
     inner = _front(0.58, 1.2, -0.021)   # right door 3.4 cm behind it, overlapping 4 cm
     coplanar = [_front(1.5, 1.9, -0.021), _front(1.904, 2.3, -0.021)]  # a hinged pair: same plane
     fronts = [outer, inner, *coplanar]
-    assert sliding_partner(outer, fronts, SlidingRules()) is inner
+    assert sliding_partner(outer, fronts, SlidingConfig()) is inner
     assert mark_sliding(fronts) == 2
     assert outer.kind == inner.kind == "sliding"
     assert outer.articulation.joint_type == inner.articulation.joint_type == "prismatic"
@@ -78,7 +79,7 @@ def test_two_track_fronts_are_sliding_doors() -> None:
 
 
 def test_offset_fronts_that_are_not_a_pair() -> None:
-    r = SlidingRules()
+    r = SlidingConfig()
     a = _front(0.0, 0.6, -0.055)
     assert sliding_partner(a, [a, _front(0.6, 1.2, -0.021, z1=0.5)], r) is None    # not as tall
     assert sliding_partner(a, [a, _front(0.7, 1.3, -0.021)], r) is None            # 10 cm apart

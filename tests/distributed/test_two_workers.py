@@ -1,4 +1,4 @@
-"""Issue 21 acceptance (slow, ~8-12 min on 2 busy cores): a real `prefect server` on 127.0.0.1, a
+"""Acceptance (slow, ~8-12 min on 2 busy cores): a real `prefect server` on 127.0.0.1, a
 process pool with two `prefect worker` processes, the convert-scene deployment, a 4-scene dataset.
 
 1. Both workers run scenes (flow-run labels), the table artifact lists all four; one worker is killed

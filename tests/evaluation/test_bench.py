@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from benchmarks.runner import SETS_DIR, load_spec, print_table, run_bench, run_isolated
+from flows.bench.runner import SETS_DIR, load_spec, print_table, run_bench, run_isolated
 from react3d_core.data.mesh import TriMesh, load_mesh, save_mesh
 from react3d_core.errors import InputError
 
@@ -19,6 +19,18 @@ def test_set_files_are_valid(tmp_path):
     assert len({e["name"] for e in heldout}) == len(heldout)
     smoke = load_spec(str(SETS_DIR / "smoke.json"), tmp_path, frames=12)
     assert len(smoke) == 2 and all(e["n_frames"] == 12 for e in smoke)
+
+
+def test_set_files_ship_as_package_data():
+    """A non-editable install finds the sets: they sit in the flows.bench package and pyproject ships them."""
+    import tomllib
+
+    import flows.bench
+
+    assert SETS_DIR == Path(flows.bench.__file__).parent / "sets"
+    assert {"heldout.json", "smoke.json"} <= {p.name for p in SETS_DIR.glob("*.json")}
+    pyproject = tomllib.loads((Path(__file__).parents[2] / "pyproject.toml").read_text())
+    assert "sets/*.json" in pyproject["tool"]["setuptools"]["package-data"]["flows.bench"]
 
 
 def test_bad_spec_is_input_error(tmp_path):
@@ -85,9 +97,10 @@ def _start_prefect_server() -> int:
     return s.server_process.pid
 
 
-def test_isolated_run_leaves_no_prefect_server_behind():
+def test_isolated_run_leaves_no_prefect_server_behind(prefect_home_copy, tmp_path, monkeypatch):
     import psutil
 
+    monkeypatch.setenv("PREFECT_HOME", str(prefect_home_copy(tmp_path / "home")))  # migrated: starts in seconds
     pid = run_isolated(_start_prefect_server)
     alive = psutil.pid_exists(pid) and psutil.Process(pid).status() != psutil.STATUS_ZOMBIE
     if alive:

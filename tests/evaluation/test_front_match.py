@@ -46,7 +46,7 @@ def test_bench_fronts_scores_a_scene(synthetic_scene, tmp_path) -> None:
     import json
 
     from benchmarks.bench_fronts import main
-    from benchmarks.runner import _gt_dir
+    from flows.bench.runner import _gt_dir
     from react3d_core.ground_truth.articulate3d import read_articulate3d
 
     root = synthetic_scene(seed=0, n_frames=12)

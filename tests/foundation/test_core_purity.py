@@ -1,5 +1,6 @@
 """react3d_core is the pure library (docs/CONTRACTS.md): importing it, or any module in it, must not
-import the orchestrator (prefect) or the model stack (torch, transformers), which live in tasks/
+import the orchestrator (prefect) or the model stack (torch, transformers, the react3d_models package that
+the perception factory imports only when the config names the models backend), which live in tasks/
 and in the ``models`` extra. Checked in a fresh interpreter, since this test session may already
 have imported them."""
 
@@ -11,7 +12,7 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-HEAVY = ("prefect", "torch", "transformers")
+HEAVY = ("prefect", "torch", "transformers", "react3d_models")
 
 _PROBE = r"""
 import importlib, json, pkgutil, sys

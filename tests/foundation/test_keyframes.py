@@ -1,4 +1,4 @@
-"""Keyframe selection by what the views add (issue 16), on hand-made pose sequences.
+"""Keyframe selection by what the views add, on hand-made pose sequences.
 
 Rules under test (FrameSelectionConfig defaults): keep a frame when the camera moved >= 5 cm or turned
 >= 3 deg since the last kept one and, with a rasterizer, when >= 5 % of what it sees has been seen by

@@ -1,5 +1,5 @@
-"""Prefect test set-up: a private PREFECT_HOME and object store per session, Prefect's test harness
-(a temporary SQLite server), quiet settings."""
+"""Prefect test set-up: a private object store and result storage per session, the run's shared Prefect
+server (``prefect_server``) as this process's API, quiet settings."""
 
 from __future__ import annotations
 
@@ -11,15 +11,32 @@ import pytest
 
 
 @pytest.fixture(scope="session", autouse=True)
-def prefect_env(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+def prefect_env(tmp_path_factory: pytest.TempPathFactory, prefect_server) -> Iterator[Path]:  # noqa: ANN001
     home = tmp_path_factory.mktemp("prefect-home")
-    os.environ["PREFECT_HOME"] = str(home)
     os.environ["REACT3D_CACHE"] = str(home / "react3d-cache")
     os.environ["PREFECT_LOCAL_STORAGE_PATH"] = str(home / "storage")
+    os.environ["PREFECT_API_URL"] = prefect_server.url
     from tasks import prefect_env as pe
 
     pe.configure()
-    from prefect.testing.utilities import prefect_test_harness
+    import prefect.context
 
-    with prefect_test_harness(server_startup_timeout=180):
+    prefect.context.refresh_global_settings_context()  # Prefect may have read its settings at collection
+    try:
         yield home
+    finally:
+        _drain()
+        del os.environ["PREFECT_API_URL"]
+        prefect.context.refresh_global_settings_context()
+
+
+def _drain() -> None:
+    """Send the logs and events still queued in this process before the server may stop."""
+    from prefect.events.worker import EventsWorker
+    from prefect.logging.handlers import APILogWorker
+
+    try:
+        APILogWorker.drain_all(timeout=30)
+    except RuntimeError:
+        pass
+    EventsWorker.drain_all(timeout=30)

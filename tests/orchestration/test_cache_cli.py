@@ -50,7 +50,7 @@ def test_cache_clean_prunes_the_quarantine(tmp_path: Path, monkeypatch) -> None:
 
 
 def test_cache_clean_prunes_collision_and_report_caches(tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
-    """Issue 18: convex decompositions and report pieces cached by content are pruned by age too."""
+    """Convex decompositions and report pieces cached by content are pruned by age too."""
     from flows.cli import main
 
     monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "cache"))

@@ -11,6 +11,7 @@ import pytest
 
 import tasks.articulation as t_art
 import tasks.perception as t_perc
+import tasks.physics as t_phys
 import tasks.segmentation as t_seg
 from flows.convert_dataset import convert_dataset
 from flows.convert_scene import convert_scene
@@ -46,16 +47,21 @@ def test_convert_then_everything_cached(scene: Path, tmp_path: Path, monkeypatch
     assert (tmp_path / "a" / "report.html").exists() and (tmp_path / "a" / "metrics.json").exists()
     assert {"perception", "segmentation", "articulation", "assembly", "export", "total"} <= set(m.timings)
     assert m.config["perception"]["backend"] == "oracle" and "react3d_core.fusion" in m.versions
+    # the physics check ran on the export (MuJoCo by default) and is recorded beside it
+    assert "physics" in m.timings and m.physics["engines"]["mujoco"]["status"] == "ok"
+    assert m.physics["engines"]["mujoco"]["joints"] == len(m.objects)
+    assert json.loads((tmp_path / "a" / "physics_check.json").read_text())["scene_id"] == m.scene_id
     counts = [_counting(monkeypatch, mod, fn) for mod, fn in ((t_perc, "perceive_body"), (t_seg, "segment_body"),
-                                                             (t_art, "articulate_body"))]
+                                                             (t_art, "articulate_body"), (t_phys, "check_body"))]
     manifest2 = convert_scene(str(scene), str(tmp_path / "b"), cfg)  # another output folder: same content keys
-    assert [len(c) for c in counts] == [0, 0, 0]
+    assert [len(c) for c in counts] == [0, 0, 0, 0]
+    assert InteractiveScene.load(manifest2).physics["engines"] == m.physics["engines"]
     assert len(InteractiveScene.load(manifest2).objects) == len(m.objects)
     # the same scan copied elsewhere hits the same cache, and the result refers to the copy's mesh
     copy = tmp_path / "copy"
     shutil.copytree(scene, copy)
     manifest3 = convert_scene(str(copy), str(tmp_path / "c"), cfg)
-    assert [len(c) for c in counts] == [0, 0, 0]
+    assert [len(c) for c in counts] == [0, 0, 0, 0]
     m3 = InteractiveScene.load(manifest3)
     assert (Path(manifest3).parent / m3.input_mesh).resolve() == (copy / "scans" / "mesh_aligned_0.05.ply").resolve()
 
@@ -110,7 +116,7 @@ def test_dataset_run_isolates_a_corrupt_scene(scene: Path, tmp_path: Path) -> No
 
 
 def test_cold_cache_recomputes_and_leaves_a_self_contained_result(scene: Path, tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
-    from benchmarks.runner import cold_cache
+    from flows.bench.runner import cold_cache
     from tasks.store import cache_root
 
     cfg = {**CFG, "perception": {"backend": "oracle", "oracle": {"seed": 14}}, "export": {"formats": []}}

@@ -51,7 +51,7 @@ def _same_as_the_flow(scene: Path, tmp_path: Path, monkeypatch, cfg: dict) -> No
     assert out.returncode == 0, out.stderr[-2000:]
     info = json.loads(out.stdout.strip().splitlines()[-1])
     assert info == {"prefect": False, "torch": False, "n": info["n"],
-                    "stages": ["articulation", "assembly", "export", "perception", "report", "segmentation"]}
+                    "stages": ["articulation", "assembly", "export", "perception", "physics", "report", "segmentation"]}
     assert info["n"] > 0
 
     flow_manifest = Path(convert_scene(str(scene), str(tmp_path / "flow"), cfg))
@@ -59,6 +59,8 @@ def _same_as_the_flow(scene: Path, tmp_path: Path, monkeypatch, cfg: dict) -> No
     assert _joints(core_manifest) == _joints(flow_manifest)
     a, b = InteractiveScene.load(core_manifest), InteractiveScene.load(flow_manifest)
     assert a.config == b.config and a.versions == b.versions
+    # the physics check ran in both (URDF only here: MuJoCo, the default engine, has no MJCF and is skipped)
+    assert {k: e["status"] for k, e in a.physics["engines"].items()} == {k: e["status"] for k, e in b.physics["engines"].items()}
     assert (tmp_path / "core" / a.input_mesh).resolve() == (tmp_path / "flow" / b.input_mesh).resolve()
     assert (tmp_path / "core" / "export" / "urdf" / "scene.urdf").is_file() and (tmp_path / "core" / "report.html").is_file()
     assert json.loads((tmp_path / "core" / "metrics.json").read_text()) == json.loads((tmp_path / "flow" / "metrics.json").read_text())

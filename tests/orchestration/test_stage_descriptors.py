@@ -1,4 +1,4 @@
-"""Stage descriptors are the one place a stage's dependencies are declared (issue #17): cache keys,
+"""Stage descriptors are the one place a stage's dependencies are declared: cache keys,
 the sections a task sees and the manifest's versions all follow from them."""
 
 from __future__ import annotations
@@ -18,19 +18,20 @@ BASE = PipelineConfig().model_dump(mode="json")
 H = {"sha256": "abc", "path": "objects/ab/abc.npz"}
 
 # For a field changed in each section, the steps whose key must change (written out by hand from the
-# pipeline's shape: perception -> fusion -> articulation -> dedup/cavity -> assembly -> texture/export).
+# pipeline's shape: perception -> fusion -> articulation -> dedup/cavity -> assembly -> texture/export -> physics).
 EXPECTED = {
-    "frames": {"perception", "segmentation", "articulation", "assembly", "export"},
-    "perception": {"perception", "segmentation", "articulation", "assembly", "export"},
-    "fusion": {"segmentation", "articulation", "assembly", "export"},
-    "topk": {"segmentation", "articulation", "assembly", "export"},
-    "clip": {"segmentation", "articulation", "assembly", "export"},
-    "articulation": {"articulation", "assembly", "export"},
-    "limits": {"assembly", "export"},
-    "cavity": {"assembly", "export"},
-    "dedup": {"assembly", "export"},
-    "assembly": {"assembly", "export"},
-    "export": {"export"},
+    "frames": {"perception", "segmentation", "articulation", "assembly", "export", "physics"},
+    "perception": {"perception", "segmentation", "articulation", "assembly", "export", "physics"},
+    "fusion": {"segmentation", "articulation", "assembly", "export", "physics"},
+    "topk": {"segmentation", "articulation", "assembly", "export", "physics"},
+    "clip": {"segmentation", "articulation", "assembly", "export", "physics"},
+    "articulation": {"articulation", "assembly", "export", "physics"},
+    "limits": {"assembly", "export", "physics"},
+    "cavity": {"assembly", "export", "physics"},
+    "dedup": {"assembly", "export", "physics"},
+    "assembly": {"assembly", "export", "physics"},
+    "export": {"export", "physics"},
+    "physics": {"physics"},
     "evaluation": set(),  # evaluation is not cached: it never changes a step's key
 }
 
@@ -57,7 +58,7 @@ def test_declaring_a_section_in_a_descriptor_is_all_it_takes(monkeypatch) -> Non
     changed = copy.deepcopy(BASE)
     changed["export"]["a_field_added_later"] = 1
     before, after = _keys(BASE), _keys(changed)
-    assert {s for s in stages.STEPS if before[s] != after[s]} == {"assembly", "export"}
+    assert {s for s in stages.STEPS if before[s] != after[s]} == {"assembly", "export", "physics"}
 
 
 def test_a_step_cannot_read_a_section_it_does_not_declare() -> None:
@@ -71,7 +72,7 @@ def test_a_step_cannot_read_a_section_it_does_not_declare() -> None:
 def test_every_stage_package_declares_itself_and_the_manifest_versions_follow() -> None:
     reg = stages.all_stages()
     assert list(reg) == ["frames", "perception", "fusion", "articulation", "dedup", "cavity", "assembly", "texture",
-                         "export", "viewer"]
+                         "export", "physics", "viewer"]
     for spec in reg.values():
         mod = importlib.import_module(spec.module)
         assert mod.STAGE is spec and spec.version == mod.STAGE_VERSION
@@ -84,7 +85,8 @@ def test_every_stage_package_declares_itself_and_the_manifest_versions_follow() 
 
 
 def test_perception_keys_name_the_model_backend_only_when_it_is_used() -> None:
-    """Workers with and without torch share heuristic keys; the key never imports the model code."""
+    """Workers with and without torch share heuristic keys; the key never imports torch, not even to name
+    the model backend's version."""
     import subprocess
     import sys
 
@@ -92,9 +94,10 @@ def test_perception_keys_name_the_model_backend_only_when_it_is_used() -> None:
 
     assert model_backend_version(BASE) == {}
     models = {**BASE, "perception": {**BASE["perception"], "backend": "models"}}
-    assert model_backend_version(models) == {"tasks.models": "2"}
-    code = ("import sys; from tasks.perception import perceive_frames; from tasks.keys import step_key; "
+    assert model_backend_version(models) == {"react3d_models": "3"}
+    code = ("import sys; from tasks.perception import perceive_frames; from tasks.keys import step_key, model_backend_version; "
             "from react3d_core.config import PipelineConfig; "
-            "step_key('perception', {'config': PipelineConfig().model_dump(mode='json')}); print('torch' in sys.modules)")
+            "step_key('perception', {'config': PipelineConfig().model_dump(mode='json')}); "
+            "model_backend_version({'perception': {'backend': 'models'}}); print('torch' in sys.modules)")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.stdout.strip().splitlines()[-1] == "False", out.stderr[-1500:]

@@ -1,4 +1,4 @@
-"""Issue 20 item 7: the content store is verified, not trusted. A flipped byte in a stored object or a
+"""The content store is verified, not trusted. A flipped byte in a stored object or a
 stored export folder is caught (one warning line), quarantined and recomputed; the corrupt copy never
 reaches a user's output; temporaries of killed runs are swept."""
 
@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from .conftest import convert_oracle_urdf as convert, isolated_env
+from .conftest import convert_oracle_urdf as convert, copy_first_run
 
 
 def _flip(path: Path, at: float = 0.5) -> None:
@@ -132,16 +132,10 @@ def test_stale_temporaries_of_killed_runs_are_swept(store: Path) -> None:
 
 # --- a real convert over a corrupted store ----------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def env(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
-    return isolated_env(tmp_path_factory.mktemp("prefect-home"))
-
-
-
-def test_convert_recomputes_flipped_export_and_objects(synthetic_scene, env: dict[str, str], tmp_path: Path) -> None:  # noqa: ANN001
+def test_convert_recomputes_flipped_export_and_objects(synthetic_scene, dresser_first_run: Path, prefect_server,  # noqa: ANN001
+                                                       tmp_path: Path) -> None:
     scene = synthetic_scene(seed=5, n_frames=12, kind="dresser")
-    first = convert(scene, tmp_path / "a", env)
-    assert first.returncode == 0, first.stderr[-3000:]
+    env = copy_first_run(dresser_first_run, tmp_path / "home", tmp_path / "a", prefect_server.home)  # first run: done
     cache = Path(env["REACT3D_CACHE"])
     urdfs = sorted(cache.glob("scenes/*/export-*/export/urdf/scene.urdf"))
     objects = sorted(cache.glob("objects/*/*.npz"))

@@ -1,4 +1,4 @@
-"""Issue 20, item 8: a failure prints one line first (what, which file, what to do), rc 2 for bad input,
+"""A failure prints one line first (what, which file, what to do), rc 2 for bad input,
 details in a log file; options and config are validated before any stage runs."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import FAST, first_line, run_cli, snapshot
+from .conftest import FAST, first_line, run_cli, run_cli_here, snapshot
 
 
 @pytest.mark.parametrize("extra, words", [
@@ -19,11 +19,10 @@ from .conftest import FAST, first_line, run_cli, snapshot
     (["--stride", "0"], "--stride must be at least 1"),
     (["--max-frames", "0"], "--max-frames must be at least 1"),
 ])
-def test_bad_options_fail_in_one_line_before_any_stage(extra: list[str], words: str, scan: Path, cli_env: dict,
-                                                       tmp_path: Path) -> None:
+def test_bad_options_fail_in_one_line_before_any_stage(extra: list[str], words: str, scan: Path, tmp_path: Path) -> None:
     (tmp_path / "list.json").write_text("[1, 2]")
     extra = [str(tmp_path / "list.json") if a == "LIST" else a for a in extra]
-    r = run_cli(["convert", str(scan), "--out", str(tmp_path / "out"), *extra], cli_env, timeout=120)
+    r = run_cli_here(["convert", str(scan), "--out", str(tmp_path / "out"), *extra])
     assert r.returncode == 2, r.stderr[-2000:]
     assert first_line(r.stderr).startswith("react3d convert: error: ") and words in first_line(r.stderr), r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and not (tmp_path / "out").exists()
@@ -58,10 +57,10 @@ def test_disk_full_is_one_line_and_leaves_nothing(small_fs: Path, scan: Path, cl
     assert list(small_fs.iterdir()) == []  # no half-written output, no staging folder
 
 
-def test_read_only_output_is_refused_before_anything_runs(small_fs: Path, scan: Path, cli_env: dict) -> None:
+def test_read_only_output_is_refused_before_anything_runs(small_fs: Path, scan: Path) -> None:
     subprocess.run(["mount", "-o", "remount,ro", str(small_fs)], check=True)
     before = snapshot(small_fs)
-    r = run_cli(["convert", str(scan), "--out", str(small_fs / "out"), *FAST], cli_env, timeout=120)
+    r = run_cli_here(["convert", str(scan), "--out", str(small_fs / "out"), *FAST])
     assert r.returncode == 2, r.stderr[-2000:]
     assert first_line(r.stderr).startswith(f"react3d convert: error: {small_fs / 'out'}: is not writable"), r.stderr
     assert len(r.stderr.strip().splitlines()) == 1 and snapshot(small_fs) == before

@@ -1,4 +1,5 @@
-"""Issue 20, item 1: ``--out`` never deletes what react3d did not create (real CLI processes)."""
+"""``--out`` never deletes what react3d did not create (the CLI in this process for
+the refusals, which happen before anything starts; a real CLI process for the allowed replacement)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import FAST, first_line, run_cli, snapshot
+from .conftest import FAST, first_line, run_cli, run_cli_here, snapshot
 
 
 def _refused(r, command: str, path: Path, words: str) -> None:  # noqa: ANN001
@@ -36,45 +37,44 @@ def _world(tmp_path: Path, scan: Path) -> tuple[Path, Path]:
     ("notes.txt", "is a file"),                # a regular file used to become a folder
     ("link", "symbolic link"),                 # a link to the user's folder
 ])
-def test_convert_refuses_an_unsafe_out_and_touches_nothing(target: str, words: str, scan: Path, cli_env: dict,
-                                                           tmp_path: Path) -> None:
+def test_convert_refuses_an_unsafe_out_and_touches_nothing(target: str, words: str, scan: Path, tmp_path: Path) -> None:
     s, docs = _world(tmp_path, scan)
     (tmp_path / "link").symlink_to(docs)
     before = snapshot(tmp_path)
-    r = run_cli(["convert", str(s), "--out", str(tmp_path / target), *FAST], cli_env, timeout=120)
+    r = run_cli_here(["convert", str(s), "--out", str(tmp_path / target), *FAST])
     _refused(r, "convert", tmp_path / target, words)
     assert snapshot(tmp_path) == before  # nothing created, moved or hidden as .NAME.old-PID
 
 
-def test_convert_dataset_refuses_parent_and_input_outputs(scan: Path, cli_env: dict, tmp_path: Path) -> None:
+def test_convert_dataset_refuses_parent_and_input_outputs(scan: Path, tmp_path: Path) -> None:
     s, docs = _world(tmp_path, scan)
     root = s.parent
     before = snapshot(tmp_path)
     # `--scenes ..` put one scene's output at the parent of --out (which then got replaced)
-    r = run_cli(["convert-dataset", str(root), "--scenes", "..", "--out", str(docs / "results"), *FAST], cli_env)
+    r = run_cli_here(["convert-dataset", str(root), "--scenes", "..", "--out", str(docs / "results"), *FAST])
     _refused(r, "convert-dataset", root / "..", "scene id")
     # --out = the dataset's parent: data/S would be the output of scene ... no, `data` is: out/<scene> = input
-    r = run_cli(["convert-dataset", str(root), "--out", str(root), *FAST], cli_env)
+    r = run_cli_here(["convert-dataset", str(root), "--out", str(root), *FAST])
     _refused(r, "convert-dataset", s, "is the input")
     # a user's folder where one scene's output would go
     (docs / "S").mkdir()
     (docs / "S" / "keep.txt").write_text("mine")
     before = snapshot(tmp_path)
-    r = run_cli(["convert-dataset", str(root), "--out", str(docs), *FAST], cli_env)
+    r = run_cli_here(["convert-dataset", str(root), "--out", str(docs), *FAST])
     _refused(r, "convert-dataset", docs / "S", "is not a react3d output")
     assert snapshot(tmp_path) == before
 
 
-def test_synth_and_export_refuse_a_users_folder(cli_env: dict, tmp_path: Path) -> None:
+def test_synth_and_export_refuse_a_users_folder(tmp_path: Path) -> None:
     docs = tmp_path / "mydocs"
     (docs / "export" / "urdf").mkdir(parents=True)
     (docs / "thesis.tex").write_text("mine")
     (docs / "export" / "urdf" / "robot.urdf").write_text("<robot/>")
     (docs / "scene.json").write_text('{"objects": []}')
     before = snapshot(tmp_path)
-    r = run_cli(["synth", "--out", str(docs), "--frames", "2"], cli_env)
+    r = run_cli_here(["synth", "--out", str(docs), "--frames", "2"])
     _refused(r, "synth", docs, "is not a react3d output")
-    r = run_cli(["export", str(docs), "--formats", "urdf"], cli_env)
+    r = run_cli_here(["export", str(docs), "--formats", "urdf"])
     _refused(r, "export", docs, "is not a react3d conversion output")
     assert snapshot(tmp_path) == before
 
@@ -97,10 +97,10 @@ def test_previous_output_is_replaced_whole_and_marked(converted: Path, scan: Pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no .out.old-PID / .out.tmp-* left
 
 
-def test_demo_refuses_a_users_folder_where_its_scene_goes(cli_env: dict, tmp_path: Path) -> None:
+def test_demo_refuses_a_users_folder_where_its_scene_goes(tmp_path: Path) -> None:
     (tmp_path / "demo_out" / "scene").mkdir(parents=True)
     (tmp_path / "demo_out" / "scene" / "notes.txt").write_text("mine")
     before = snapshot(tmp_path)
-    r = run_cli(["demo", "--out", str(tmp_path / "demo_out")], cli_env, timeout=120)
+    r = run_cli_here(["demo", "--out", str(tmp_path / "demo_out")])
     _refused(r, "demo", tmp_path / "demo_out" / "scene", "is not a react3d output")
     assert snapshot(tmp_path) == before

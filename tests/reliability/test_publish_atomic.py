@@ -1,4 +1,4 @@
-"""Issue 20, item 2: a run killed at any point leaves the old output as it was, or the new one complete;
+"""A run killed at any point leaves the old output as it was, or the new one complete;
 what killed runs left is cleaned by the next run, and only when it is ours."""
 
 from __future__ import annotations

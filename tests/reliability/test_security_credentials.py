@@ -1,4 +1,4 @@
-"""Issue 20 item 6: an API key never travels in an endpoint URL (it would be stored in scene.json and in
+"""An API key never travels in an endpoint URL (it would be stored in scene.json and in
 Prefect's flow-run parameters); keys come from the environment or a Prefect Secret block."""
 
 from __future__ import annotations
@@ -34,19 +34,19 @@ def test_endpoint_with_credentials_is_a_config_error_that_does_not_echo_it(field
     from react3d_core.errors import ConfigError
 
     with pytest.raises(ConfigError) as e:
-        PipelineConfig().with_overrides({"perception": {field: value}})
+        PipelineConfig().with_overrides({"perception": {"models": {field: value}}})
     msg = str(e.value)
-    assert SECRET not in msg and f"perception.{field}" in msg and "environment" in msg and "\n" not in msg
+    assert SECRET not in msg and f"perception.models.{field}" in msg and "environment" in msg and "\n" not in msg
     with pytest.raises(ConfigError):
-        PipelineConfig.model_validate({"perception": {field: value}})
+        PipelineConfig.model_validate({"perception": {"models": {field: value}}})
 
 
 @pytest.mark.parametrize("value", ["http://127.0.0.1:8000/v1", "https://api.example.com/v1?model=llava&monkey=1",
                                    "python opd_server.py --port 9000 --keyframes 5", "/opt/opdmulti/run.sh"])
 def test_plain_endpoints_are_accepted(value: str) -> None:
-    from react3d_core.config import PerceptionConfig
+    from react3d_core.config import ModelsConfig
 
-    assert PerceptionConfig(tag_filter_endpoint=value, articulation_endpoint=value).articulation_endpoint == value
+    assert ModelsConfig(tag_filter_endpoint=value, articulation_endpoint=value).articulation_endpoint == value
 
 
 def test_convert_refuses_a_key_in_the_config_and_stores_it_nowhere(synthetic_scene, tmp_path: Path) -> None:  # noqa: ANN001
@@ -55,7 +55,7 @@ def test_convert_refuses_a_key_in_the_config_and_stores_it_nowhere(synthetic_sce
     env = {k: v for k, v in os.environ.items() if not k.startswith(("PREFECT_", "REACT3D_"))}
     env.update(PREFECT_HOME=str(home), PREFECT_LOCAL_STORAGE_PATH=str(home / "storage"),
                REACT3D_CACHE=str(home / "cache"), PYTHONPATH=str(ROOT))
-    cfg = {"perception": {"backend": "oracle", "tag_filter_endpoint": f"https://api.example.com/v1?api_key={SECRET}"}}
+    cfg = {"perception": {"backend": "oracle", "models": {"tag_filter_endpoint": f"https://api.example.com/v1?api_key={SECRET}"}}}
     p = subprocess.run([sys.executable, "-m", "flows.cli", "convert", str(scene), "--out", str(tmp_path / "out"),
                         "--config", json.dumps(cfg)], env=env, cwd=ROOT, capture_output=True, text=True, timeout=600,
                        start_new_session=True)
@@ -86,8 +86,8 @@ class _Recorder(BaseHTTPRequestHandler):
 
 def test_keys_come_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None:
     pytest.importorskip("torch")
-    from tasks.models.opdmulti import OPDMultiClient
-    from tasks.models.runtime import api_key
+    from react3d_models.opdmulti import OPDMultiClient
+    from react3d_models.runtime import api_key
 
     monkeypatch.delenv("REACT3D_OPDMULTI_API_KEY_BLOCK", raising=False)
     monkeypatch.setenv("REACT3D_OPDMULTI_API_KEY", SECRET)
@@ -108,31 +108,29 @@ def test_keys_come_from_the_environment(monkeypatch: pytest.MonkeyPatch) -> None
 SECRET_BLOCK = """
 import os, sys
 from prefect.blocks.system import Secret
-from prefect.testing.utilities import prefect_test_harness
-from tasks.models.runtime import api_key
-with prefect_test_harness(server_startup_timeout=300):
-    Secret(value=sys.argv[1]).save("react3d-opdmulti-key")
-    os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "react3d-opdmulti-key"
-    print("KEY", api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK") == sys.argv[1])
-    os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "no-such-block"
-    try:
-        api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK")
-    except Exception as exc:
-        print("MISSING", type(exc).__name__, str(exc))
+from react3d_models.runtime import api_key
+Secret(value=sys.argv[1]).save("react3d-opdmulti-key")
+os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "react3d-opdmulti-key"
+print("KEY", api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK") == sys.argv[1])
+os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "no-such-block"
+try:
+    api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK")
+except Exception as exc:
+    print("MISSING", type(exc).__name__, str(exc))
 """
 
 
-def test_keys_come_from_a_prefect_secret_block(tmp_path: Path) -> None:
-    """A real Prefect server (the test harness, in its own process): the key is read from a Secret block."""
+def test_keys_come_from_a_prefect_secret_block(tmp_path: Path, prefect_server) -> None:  # noqa: ANN001
+    """A real Prefect server (the run's, used from another process): the key is read from a Secret block."""
     pytest.importorskip("torch")
     env = {k: v for k, v in os.environ.items() if not k.startswith(("PREFECT_", "REACT3D_"))}
-    env.update(PREFECT_HOME=str(tmp_path / "prefect"), PYTHONPATH=str(ROOT), PREFECT_SERVER_ANALYTICS_ENABLED="false",
-               PREFECT_LOGGING_LEVEL="ERROR", PREFECT_SERVER_LOGGING_LEVEL="CRITICAL")
+    env.update(PREFECT_HOME=str(tmp_path / "prefect"), PREFECT_API_URL=prefect_server.url, PYTHONPATH=str(ROOT),
+               PREFECT_LOGGING_LEVEL="ERROR")
     p = subprocess.Popen([sys.executable, "-c", SECRET_BLOCK, SECRET], env=env, cwd=ROOT, text=True,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
     try:
         out, err = p.communicate(timeout=600)
-    finally:  # the harness's server must not outlive the test
+    finally:  # nothing it started outlives the test
         with contextlib.suppress(ProcessLookupError, PermissionError):
             os.killpg(p.pid, signal.SIGKILL)
     assert "KEY True" in out, err[-2000:]

@@ -1,4 +1,4 @@
-"""Issue 20 item 10: ``--perception models`` without weights fails in seconds with one line, instead of
+"""``--perception models`` without weights fails in seconds with one line, instead of
 minutes of hub retries. Nothing is downloaded: the hub endpoint is a loopback socket that never answers
 (what a closed network looks like to an HTTP client), and the Hugging Face cache is an empty folder."""
 
@@ -57,8 +57,8 @@ def _env(tmp_path: Path, hub: str, offline: bool) -> dict[str, str]:
 
 
 BUILD = ("from react3d_core.config import PerceptionConfig\n"
-         "from tasks.models import make_model_perception\n"
-         "make_model_perception(PerceptionConfig(backend='models', device='cpu'))\n")
+         "from react3d_models import make_model_perception\n"
+         "make_model_perception(PerceptionConfig(backend='models', models={'device': 'cpu'}))\n")
 
 
 @pytest.mark.parametrize("offline", [False, True], ids=["hub-silent", "HF_HUB_OFFLINE"])
@@ -70,7 +70,7 @@ def test_missing_weights_fail_in_seconds_with_one_line(tmp_path: Path, silent_hu
     seconds = time.perf_counter() - t0
     assert p.returncode != 0
     last = p.stderr.strip().splitlines()[-1]
-    assert last.startswith("tasks.models.runtime.ModelUnavailableError: model weights not available on this machine")
+    assert last.startswith("react3d_models.runtime.ModelUnavailableError: model weights not available on this machine")
     for model in ("IDEA-Research/grounding-dino-tiny", "facebook/sam-vit-huge", "llava-hf/llava-1.5-7b-hf"):
         assert model in last  # every missing model named at once, not one per attempt
     assert ("HF_HUB_OFFLINE=1" if offline else "did not answer within 3 s") in last
@@ -83,7 +83,7 @@ def test_missing_weights_fail_in_seconds_with_one_line(tmp_path: Path, silent_hu
 
 
 def test_probe_asks_the_hub_once(silent_hub) -> None:  # noqa: ANN001
-    from tasks.models.runtime import HUB_PROBE_TIMEOUT_S, hub_reachable
+    from react3d_models.runtime import HUB_PROBE_TIMEOUT_S, hub_reachable
 
     hub, connections = silent_hub
     os.environ["HF_ENDPOINT"] = hub
@@ -98,12 +98,12 @@ def test_probe_asks_the_hub_once(silent_hub) -> None:  # noqa: ANN001
 
 
 def test_local_folder_is_found_without_the_hub(tmp_path: Path) -> None:
-    from tasks.models.runtime import ModelNeed, ModelUnavailableError, check_models_available, hub_kwargs, locally_available
+    from react3d_models.runtime import ModelNeed, ModelUnavailableError, check_models_available, hub_kwargs, locally_available
 
     local = tmp_path / "my-sam"
     local.mkdir()
     (local / "config.json").write_text("{}")
     assert locally_available(str(local)) and hub_kwargs(str(local)) == {"local_files_only": True}
     check_models_available([ModelNeed("SAM", str(local), "sam_model")])  # no probe, no error
-    with pytest.raises(ModelUnavailableError, match="local folder does not exist.*perception.sam_model"):
+    with pytest.raises(ModelUnavailableError, match="local folder does not exist.*perception.models.sam_model"):
         check_models_available([ModelNeed("SAM", str(tmp_path / "typo"), "sam_model")])

@@ -1,10 +1,10 @@
-"""Item 4 of issue 20: a forged Prefect result record in the shared storage must never run code.
+"""A forged Prefect result record in the shared storage must never run code.
 
 Prefect 3 decodes a record with the serializer the record itself names. These tests forge records the
 way an attacker with write access to ``$PREFECT_HOME/storage`` would (``serializer: pickle``, JSON with
 ``jsonlib: pickle``, JSON with ``object_decoder: subprocess.Popen``), each carrying a payload that
 creates a marker file when decoded, and run a
-real ``react3d convert`` process on a real (temporary) Prefect server over them.
+real ``react3d convert`` process on a real Prefect server over them.
 """
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from .conftest import convert_oracle_urdf as convert, isolated_env
+from .conftest import convert_oracle_urdf as convert, copy_first_run
 
 
 class _Touch:
@@ -109,16 +109,10 @@ def test_forged_records_are_refused_before_decoding(tmp_path: Path, forge) -> No
 
 # --- a real convert over a forged storage ---------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def env(tmp_path_factory: pytest.TempPathFactory) -> dict[str, str]:
-    return isolated_env(tmp_path_factory.mktemp("prefect-home"))
-
-
-
-def test_forged_records_in_shared_storage_do_not_run(synthetic_scene, env: dict[str, str], tmp_path: Path) -> None:  # noqa: ANN001
+def test_forged_records_in_shared_storage_do_not_run(synthetic_scene, dresser_first_run: Path, prefect_server,  # noqa: ANN001
+                                                     tmp_path: Path) -> None:
     scene = synthetic_scene(seed=5, n_frames=12, kind="dresser")
-    first = convert(scene, tmp_path / "a", env)
-    assert first.returncode == 0, first.stderr[-3000:]
+    env = copy_first_run(dresser_first_run, tmp_path / "home", tmp_path / "a", prefect_server.home)  # first run: done
     storage = Path(env["PREFECT_LOCAL_STORAGE_PATH"])
     records = sorted(p for p in storage.iterdir() if p.is_file() and p.name.split("-")[0] in
                      {"perception", "segmentation", "articulation", "assembly", "export"})

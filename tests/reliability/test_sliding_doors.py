@@ -1,4 +1,4 @@
-"""Issue 16 acceptance: a synthetic room with sliding doors, converted by the CLI with oracle perception
+"""Acceptance: a synthetic room with sliding doors, converted by the CLI with oracle perception
 (GT says "sliding") and with the heuristic (two fronts a track apart), ends with each sliding door's URDF
 joint moving in the front plane (the GT axis, sign included) and the drawers of the same room still
 pulled out of their fronts."""

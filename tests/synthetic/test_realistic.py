@@ -208,7 +208,7 @@ def test_canonical_mesh_ignores_input_order() -> None:
 
 
 def test_bench_sets_pass_scan_options() -> None:
-    from benchmarks.runner import load_spec
+    from flows.bench.runner import load_spec
 
     heldout = load_spec("heldout", Path("/nonexistent"))
     assert heldout[0]["name"] == "procedural_kitchen_100" and heldout[0]["synth"] == {}
@@ -223,6 +223,39 @@ def test_bench_sets_pass_scan_options() -> None:
     assert {(e["seed"], e["synth"]["mesh"]) for e in second} == {(s, m) for s in range(12, 18) for m in ("laser", "tsdf")}
     held = {e["seed"] for e in heldout} | set(range(200, 211))
     assert not held & ({e["seed"] for e in tuning} | {e["seed"] for e in second})  # tuning never touches held-apart seeds
+
+
+HELD_APART = ("heldout", "heldout_laser", "heldout_tsdf", "large_kitchens", "free_standing_heldout", "glass_heldout", "dark_heldout")
+TUNING = ("tuning_realistic", "tuning_realistic_2", "wardrobes_tuning", "large_kitchens_tuning", "free_standing_tuning",
+          "glass_tuning", "dark_tuning")
+
+
+def test_tuning_and_held_apart_seeds_never_overlap() -> None:
+    """No seed of any tuning set is a seed of any held-apart set (whatever the kind), and every set file
+    is one or the other (or the smoke check)."""
+    from flows.bench.runner import SETS_DIR, load_spec
+
+    seeds = {name: {e["seed"] for e in load_spec(name, Path("/nonexistent"))} for name in HELD_APART + TUNING}
+    held = set().union(*(seeds[n] for n in HELD_APART))
+    for name in TUNING:
+        assert not seeds[name] & held, (name, sorted(seeds[name] & held))
+    assert {p.stem for p in SETS_DIR.glob("*.json")} == set(HELD_APART + TUNING) | {"smoke"}
+
+
+def test_new_held_apart_sets() -> None:
+    """Free-standing (>= 8 scenes, >= 40 parts), glass and dark-front held-apart sets: realistic meshes,
+    photo images, their own kinds; the dark one drops depth."""
+    from flows.bench.runner import load_spec
+
+    fs = load_spec("free_standing_heldout", Path("/nonexistent"))
+    assert len(fs) >= 8 and {e["kind"] for e in fs} == {"furniture", "appliances"}
+    assert sum(len(build_room(e["seed"], e["kind"]).parts) for e in fs) >= 40
+    for name, kind in (("free_standing_heldout", None), ("glass_heldout", "glass"), ("dark_heldout", "dark")):
+        entries = load_spec(name, Path("/nonexistent"))
+        assert len(entries) >= 8 and all(e["synth"]["mesh"] in ("laser", "tsdf") and e["synth"]["realism"] == "photo" for e in entries)
+        assert kind is None or {e["kind"] for e in entries} == {kind}
+    dark = load_spec("dark_heldout", Path("/nonexistent"))
+    assert all(e["synth"]["depth_dropout"] == "dark" and e["name"].endswith("_dropout-dark") for e in dark)
 
 
 def test_synth_cli_scan_options(tmp_path: Path, capsys) -> None:  # noqa: ANN001

@@ -1,5 +1,5 @@
 """``react3d synth --source urdf --up/--scale``: a Y-up asset stands up again, lengths scale, and a wrong
-up axis is warned about (issue 16: a Y-up asset used to be rendered lying on its side without a word)."""
+up axis is warned about (a Y-up asset used to be rendered lying on its side without a word)."""
 
 from __future__ import annotations
 

@@ -79,7 +79,7 @@ def test_thumbnail_crops_around_the_silhouette():
 
 
 def test_report_cache_reuses_payload_but_shows_this_runs_timings(toy_scene, tmp_path):
-    """Issue 18: a re-convert reads the viewer payload (and thumbnails) back by content; the page still
+    """A re-convert reads the viewer payload (and thumbnails) back by content; the page still
     carries the current manifest's timings, and a changed mesh is a new entry."""
     import json
     import shutil

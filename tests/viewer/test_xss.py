@@ -1,4 +1,4 @@
-"""Issue 20 item 5: manifest text (labels, frame ids, limit sources) never runs as script in the viewer
+"""Manifest text (labels, frame ids, limit sources) never runs as script in the viewer
 or the report, and the page's Content-Security-Policy blocks script it did not ship."""
 
 from __future__ import annotations

@@ -7,75 +7,89 @@ the segmenter, the point segmenter and the predictor share them.
 
 from __future__ import annotations
 
+import importlib
 import logging
 from collections import OrderedDict
-from collections.abc import Sequence
-from typing import Any
-
+from collections.abc import Callable, Sequence
 import cv2
 import numpy as np
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import HeuristicConfig, LineConfig
 from ...data.frames import Frame, SceneInput
 from ...data.masks import ArticulationPrediction, Mask2D
 from ...data.mesh import TriMesh, load_mesh
+from ...errors import ConfigError
 from ...raster import Rasterizer
 from ...scene_io.images import frame_rgb
 from .facets import planar_facets
+from .constants import COLOUR_NDIM, RGB
 from .fronts import Front, find_fronts
-from .image_fronts import ImageFrontParams, ImageFronts, find_image_fronts, floor_level, params_from_config
+from .image_fronts import ImageFronts, find_image_fronts, floor_level
 from .reach import drawers_within_reach
-from .room_walls import keep_room_doors, room_wall_from_config
-from .sliding import SlidingRules, mark_sliding, sliding_from_config
-from .splashback import on_worktop, splashback_from_config
+from .room_walls import keep_room_doors
+from .sliding import mark_sliding
+from .splashback import on_worktop
 
 log = logging.getLogger("react3d.perception")
 
 OPENABLE_TAGS = ("cabinet", "drawer", "door", "wardrobe", "dresser", "refrigerator", "oven", "dishwasher")
-_FROM_CONFIG: Any = object()  # image/sliding parameters not given: built from the config
+# confidences the backend reports (fixed: the heuristic has no scores of its own)
+MASK_SCORE = 0.9  # a front's mask in a frame
+POINT_MASK_SCORE = 0.8  # the mask under point prompts (a front, else a facet)
+JOINT_SCORE = 0.7  # a front's joint guess
+_RENDER_CACHE = 16  # frames whose renders are kept: the segmenter, point segmenter and predictor share them
+# the learned line-segment detector (perception.heuristic.lines) loads weights and a tflite runtime, so it
+# lives outside the core: (module, loader taking the LineConfig), imported only when the section is enabled
+LINE_DETECTOR = ("react3d_models.line_segments", "load_line_detector")
+
+
+def load_line_detector(cfg: LineConfig) -> Callable[[np.ndarray], np.ndarray]:
+    """The line-segment detector ``perception.heuristic.lines`` asks for (an RGB image -> segments (N, 4+)),
+    from the weight-backed package; a ConfigError (one line) when it cannot be loaded."""
+    module, attr = LINE_DETECTOR
+    try:
+        loader = getattr(importlib.import_module(module), attr)
+    except ImportError as exc:
+        raise ConfigError(f"perception.heuristic.lines needs the {module} module of this package: {exc}") from None
+    return loader(cfg)
 
 
 class HeuristicModel:
     """Facets, fronts and per-frame renders of one scene. Every threshold comes from ``config``
-    (``perception.heuristic``; defaults when None); ``image`` / ``sliding`` override the image path's
-    and the sliding-door rule's parameters (None switches that step off)."""
+    (``perception.heuristic``; defaults when None). ``line_detector``: the learned line-segment detector
+    to use when ``lines.enabled`` (default: the one the section names, loaded here)."""
 
-    def __init__(self, scene: SceneInput, config: HeuristicConfig | None = None, *,
-                 image: ImageFrontParams | None = _FROM_CONFIG, sliding: SlidingRules | None = _FROM_CONFIG) -> None:
+    def __init__(self, scene: SceneInput, config: HeuristicConfig | None = None,
+                 line_detector: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
         h = config if config is not None else HeuristicConfig()
-        if image is _FROM_CONFIG:
-            image = params_from_config(h) if h.image_fronts else None
-        if sliding is _FROM_CONFIG:
-            sliding = sliding_from_config(h)
         rules = h.fronts
         self.config = h
         self.scene = scene
         self.mesh: TriMesh = load_mesh(scene.mesh_path)
         self.raster = Rasterizer(self.mesh)
-        self.scale = h.render_scale
-        self.facets = planar_facets(self.mesh, h.facet_weld_m, h.facet_max_angle_deg)
+        self.scale = h.render.scale
+        self.facets = planar_facets(self.mesh, h.facets)
         self._cache: OrderedDict[str, tuple[np.ndarray, np.ndarray]] = OrderedDict()
-        visible, glimpsed, view_dirs = self._visible_facets(h.n_probe)
+        visible, glimpsed, view_dirs = self._visible_facets(h.probe.frames)
         cams = np.array([f.c2w[:3, 3] for f in scene.frames])
         self.fronts: list[Front] = find_fronts(self.mesh, self.facets, visible, cams.mean(0), rules, glimpsed, view_dirs)
         self.image: ImageFronts | None = None
-        if image is not None and self._has_colour():
+        if h.image.enabled and self._has_colour():
             taken = np.zeros(self.mesh.n_faces, bool)
             for fr in self.fronts:
                 taken[fr.faces] = True
-            self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, rules, image, taken,
-                                           self.fronts)
+            if h.lines.enabled and line_detector is None:
+                line_detector = load_line_detector(h.lines)
+            self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, h, taken, self.fronts,
+                                           line_detector)
             self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
-        worktop = splashback_from_config(h)
-        if worktop is not None:  # fronts flush with the wall right above a worktop are splash-back
-            self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, worktop)) if not drop]
-        walls = room_wall_from_config(h)
-        if walls is not None:  # on the room's outer walls only room doors open
-            self.fronts = keep_room_doors(self.fronts, self.mesh, walls, rules, self.facets.labels)
-        if h.drawer_max_top > 0 and self.fronts:  # drawers are within reach
-            self.fronts = drawers_within_reach(self.fronts, floor_level(self.mesh, h.floor_min_area), h.drawer_max_top)
-        if sliding is not None:
-            mark_sliding(self.fronts, sliding)  # two fronts a track apart: sliding doors
+        if h.splashback.enabled:  # fronts flush with the wall right above a worktop are splash-back
+            self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, h.splashback)) if not drop]
+        if h.room_wall.enabled:  # on the room's outer walls only room doors open
+            self.fronts = keep_room_doors(self.fronts, self.mesh, h.room_wall, rules, h.floor, self.facets.labels)
+        if h.reach.drawer_max_top > 0 and self.fronts:  # drawers are within reach
+            self.fronts = drawers_within_reach(self.fronts, floor_level(self.mesh, h.floor), h.reach.drawer_max_top)
+        mark_sliding(self.fronts, h.sliding)  # two fronts a track apart: sliding doors
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
         for i, fr in enumerate(self.fronts):
             self.face_front[fr.faces] = i
@@ -90,35 +104,35 @@ class HeuristicModel:
         except Exception as exc:  # noqa: BLE001 - any unreadable colour means: no image evidence
             log.warning("heuristic: colour frames unreadable (%s); finding fronts on the mesh only", exc)
             return False
-        if img.ndim != 3 or img.shape[2] < 3 or float(img.std()) == 0.0:
+        if img.ndim != COLOUR_NDIM or img.shape[2] < RGB or float(img.std()) == 0.0:
             log.warning("heuristic: frames carry no colour; finding fronts on the mesh only")
             return False
         return True
 
     def _visible_facets(self, n_probe: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per facet: clearly visible (>= ``probe_min_px`` px over >= ``probe_min_views`` probe views of
-        >= ``probe_view_px`` px), glimpsed (any pixel), and the pixel-weighted sum of unit directions
+        """Per facet: clearly visible (>= ``probe.min_px`` px over >= ``probe.min_views`` probe views of
+        >= ``probe.view_px`` px), glimpsed (any pixel), and the pixel-weighted sum of unit directions
         towards the cameras that saw it (orients its normal)."""
-        h = self.config
+        h = self.config.probe
         idx = np.unique(np.linspace(0, len(self.scene.frames) - 1, min(n_probe, len(self.scene.frames))).round().astype(int))
         px = np.zeros(self.facets.n, np.int64)
         seen = np.zeros(self.facets.n, np.int64)
-        dirs = np.zeros((self.facets.n, 3))
         centroids = self.mesh.face_centroids
+        dirs = np.zeros((self.facets.n, centroids.shape[1]))
         for i in idx:
             f = self.scene.frames[i]
-            intr = f.intrinsics.scaled(max(1, f.intrinsics.width // 4), max(1, f.intrinsics.height // 4))
+            intr = f.intrinsics.scaled(max(1, f.intrinsics.width // h.downscale), max(1, f.intrinsics.height // h.downscale))
             ids = self.raster.render(intr.K, f.c2w, intr.width, intr.height).face_ids
             hit = ids[ids >= 0]
             lab = self.facets.labels[hit]
             c = np.bincount(lab, minlength=self.facets.n)
             px += c
-            seen += c >= h.probe_view_px
+            seen += c >= h.view_px
             to_cam = f.c2w[:3, 3] - centroids[hit]
             to_cam /= np.maximum(np.linalg.norm(to_cam, axis=1, keepdims=True), 1e-9)
-            for ax in range(3):
+            for ax in range(dirs.shape[1]):
                 dirs[:, ax] += np.bincount(lab, weights=to_cam[:, ax], minlength=self.facets.n)
-        return (px >= h.probe_min_px) & (seen >= h.probe_min_views), px > 0, dirs
+        return (px >= h.min_px) & (seen >= h.min_views), px > 0, dirs
 
     def render(self, frame: Frame) -> tuple[np.ndarray, np.ndarray]:
         """(front id, face id) images at the frame's RGB size; -1 = none."""
@@ -132,14 +146,14 @@ class HeuristicModel:
         ids = cv2.resize(ids, (W, H), interpolation=cv2.INTER_NEAREST)
         fronts = self.face_front[np.where(ids >= 0, ids, self.mesh.n_faces)]
         self._cache[frame.frame_id] = (fronts, ids)
-        if len(self._cache) > 16:
+        if len(self._cache) > _RENDER_CACHE:
             self._cache.popitem(last=False)
         return fronts, ids
 
     def masks(self, frame: Frame) -> list[tuple[int, np.ndarray]]:
         fronts, _ = self.render(frame)
         counts = np.bincount(fronts[fronts >= 0].ravel(), minlength=len(self.fronts))
-        return [(int(k), fronts == k) for k in np.flatnonzero(counts >= self.config.min_mask_px)]
+        return [(int(k), fronts == k) for k in np.flatnonzero(counts >= self.config.render.min_mask_px)]
 
 
 def _box(mask: np.ndarray) -> tuple[float, float, float, float]:
@@ -169,7 +183,8 @@ class HeuristicSegmenter:
     def segment(self, frames: Sequence[Frame], images: Sequence[np.ndarray], phrases: Sequence[str]) -> list[list[Mask2D]]:
         out = []
         for f in frames:
-            out.append([Mask2D(frame_id=f.frame_id, label=self.model.fronts[k].kind or "openable", score=0.9, mask=m, box=_box(m))
+            out.append([Mask2D(frame_id=f.frame_id, label=self.model.fronts[k].kind or "openable", score=MASK_SCORE, mask=m,
+                               box=_box(m))
                         for k, m in self.model.masks(f)])
         return out
 
@@ -200,7 +215,7 @@ class HeuristicPointSegmenter:
             lab = self.model.facets.labels
             k = np.bincount(lab[fid]).argmax()
             m = (ids >= 0) & (lab[np.maximum(ids, 0)] == k)
-        return Mask2D(frame_id=frame.frame_id, mask=m, score=0.8, box=_box(m) if m.any() else None)
+        return Mask2D(frame_id=frame.frame_id, mask=m, score=POINT_MASK_SCORE, box=_box(m) if m.any() else None)
 
 
 class HeuristicArticulation:
@@ -219,7 +234,7 @@ class HeuristicArticulation:
                 axis = w2c[:3, :3] @ np.asarray(a.axis)
                 origin = w2c[:3, :3] @ np.asarray(a.origin) + w2c[:3, 3]
                 preds.append(ArticulationPrediction(frame_id=f.frame_id, mask=m, joint_type=a.joint_type,
-                                                    axis_cam=tuple(axis), origin_cam=tuple(origin), score=0.7,
+                                                    axis_cam=tuple(axis), origin_cam=tuple(origin), score=JOINT_SCORE,
                                                     sliding=self.model.fronts[k].kind == "sliding"))
             out.append(preds)
         return out

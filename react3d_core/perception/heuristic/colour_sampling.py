@@ -9,6 +9,10 @@ import cv2
 import numpy as np
 
 from ...data.frames import Frame
+from .constants import REFERENCE_WIDTH_PX
+
+_VHW = 3  # a (views, rows, columns) stack has one channel; (views, rows, columns, channels) several
+_REMAP_ROW = 1024  # points are remapped in rows of this many: cv2.remap's maps must stay under 32767 a side
 
 
 @dataclass(frozen=True)
@@ -27,7 +31,7 @@ def pixel_coords(xn: np.ndarray, f: Frame, W: int, H: int, c: ColourCalibration)
     """Pixel coords in ``f``'s colour image of size W x H of normalised coords ``xn`` (..., 2), under
     calibration ``c`` (its shift is in px at 640 px width)."""
     intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
-    s = W / 640.0
+    s = W / REFERENCE_WIDTH_PX
     x = (c.scale * intr.fx * xn[..., 0] + intr.cx + c.dx * s).astype(np.float32)
     y = (c.scale * intr.fy * xn[..., 1] + intr.cy + c.dy * s).astype(np.float32)
     return x, y
@@ -49,10 +53,10 @@ def remap_points(img: np.ndarray, x: np.ndarray, y: np.ndarray) -> np.ndarray:
     n = len(x)
     if n == 0:
         return np.zeros(0, img.dtype)
-    m = -(-n // 1024) * 1024
+    m = -(-n // _REMAP_ROW) * _REMAP_ROW
     mx, my = np.full(m, -1, np.float32), np.full(m, -1, np.float32)
     mx[:n], my[:n] = x, y
-    out = cv2.remap(img, mx.reshape(-1, 1024), my.reshape(-1, 1024), cv2.INTER_LINEAR,
+    out = cv2.remap(img, mx.reshape(-1, _REMAP_ROW), my.reshape(-1, _REMAP_ROW), cv2.INTER_LINEAR,
                     borderMode=cv2.BORDER_CONSTANT, borderValue=0)
     return out.reshape(-1)[:n]
 
@@ -61,7 +65,7 @@ def nanmedian(stack: np.ndarray) -> np.ndarray:
     """Per-pixel median over views (axis 0 of a (V, H, W) or (V, H, W, C) stack) ignoring NaN, 0 where
     no view. Sort-based, one channel at a time (numpy's nanmedian is ~10x slower and copies the stack)."""
     out = np.zeros(stack.shape[1:], np.float32)
-    chans = [None] if stack.ndim == 3 else range(stack.shape[-1])
+    chans = [None] if stack.ndim == _VHW else range(stack.shape[-1])
     for c in chans:
         a = stack if c is None else stack[..., c]
         a = np.where(np.isfinite(a), a, np.inf).astype(np.float32)

@@ -13,11 +13,9 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import FacetConfig
 from ...data.mesh import TriMesh
 from ...geometry import edge_adjacency
-
-_DEFAULT = HeuristicConfig()  # defaults live in the config (perception.heuristic.facet_*)
 
 
 def weld(vertices: np.ndarray, tol: float) -> np.ndarray:
@@ -41,18 +39,18 @@ class Facets:
         return len(self.areas)
 
 
-def planar_facets(mesh: TriMesh, weld_m: float = _DEFAULT.facet_weld_m, max_angle_deg: float = _DEFAULT.facet_max_angle_deg) -> Facets:
+def planar_facets(mesh: TriMesh, cfg: FacetConfig = FacetConfig()) -> Facets:
     """Split the mesh into facets (see module docstring); fully vectorized. The pipeline passes
-    ``perception.heuristic.facet_weld_m`` / ``facet_max_angle_deg``."""
-    rep = weld(mesh.vertices, weld_m)
+    ``perception.heuristic.facets``."""
+    rep = weld(mesh.vertices, cfg.weld_m)
     faces = rep[mesh.faces]
     normals, areas = mesh.face_normals, mesh.face_areas
     pairs = edge_adjacency(faces, chain="corner")  # the chain order facets were always built with
-    ok = (normals[pairs[:, 0]] * normals[pairs[:, 1]]).sum(1) >= np.cos(np.radians(max_angle_deg))
+    ok = (normals[pairs[:, 0]] * normals[pairs[:, 1]]).sum(1) >= np.cos(np.radians(cfg.max_angle_deg))
     p = pairs[ok]
     g = coo_matrix((np.ones(len(p)), (p[:, 0], p[:, 1])), shape=(len(faces), len(faces)))
     n_lab, labels = connected_components(g, directed=False)
-    fa = np.zeros((n_lab, 3))
+    fa = np.zeros((n_lab, normals.shape[1]))
     np.add.at(fa, labels, normals * areas[:, None])
     area = np.bincount(labels, weights=areas, minlength=n_lab)
     fn = fa / np.maximum(np.linalg.norm(fa, axis=1), 1e-15)[:, None]

@@ -6,7 +6,9 @@ guillotine cuts: a run splits into columns, a column into drawers). Handles are 
 blobs whose colour differs from their surroundings (metal bars on paint). A cell still holding two
 handles side by side (or stacked) is split between them at the strongest seam evidence, so a missed
 seam costs nothing when both fronts have handles. Everything is in grid pixels of the orthophoto;
-thresholds are in metres or brightness ratios (the orthophoto is exposure-normalised to ~1).
+thresholds are in metres or brightness ratios (the orthophoto is exposure-normalised to ~1), in the
+sections ``seams``, ``handles`` and ``cells`` of ``perception.heuristic`` (``image.texture_factor`` raises
+seam and handle thresholds on textured planes).
 """
 
 from __future__ import annotations
@@ -19,38 +21,15 @@ import cv2
 import numpy as np
 from scipy import ndimage
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import CellConfig, HandleConfig, HeuristicConfig, SeamConfig
+from .constants import CONNECTIVITY, MAD_SIGMA, MIN_KERNEL, NEIGHBOURS, RGB
 from .orthophoto import Orthophoto
 
-_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic)
-
-
-@dataclass(frozen=True)
-class CellParams:
-    """Seam/handle/cell parameters, built from ``HeuristicConfig`` by ``image_fronts.params_from_config``."""
-
-    seam_contrast: float = _H.seam_contrast      # a seam pixel is this much darker than both sides (fraction of mean)
-    seam_span: float = _H.seam_span              # a seam covers this fraction of the cell's seen extent ...
-    seam_prominence: float = _H.seam_prominence  # ... and this much more than the lines around it (median over 2 x min_front)
-    seam_prominence_h: float = _H.seam_prominence_h  # the same for horizontal seams (reflections of table edges, shelves are horizontal)
-    min_front: float = _H.min_front_side         # m: no cell narrower than this
-    handle_contrast: float = _H.handle_contrast  # colour distance of handle pixels from the local background
-    handle_len: tuple[float, float] = _H.handle_len      # m: long side of a handle
-    handle_thick: tuple[float, float] = _H.handle_thick  # m: short side of a handle (protruding bars smear by parallax)
-    handle_aspect: float = _H.handle_aspect
-    background_win: float = _H.handle_background_win  # m: window of the local background for handles
-    min_seen: float = _H.cell_min_seen           # a cell's mesh coverage fraction
-    max_clutter: float = _H.max_clutter          # fraction of a cell's pixels off its local background (posters, tiles, shelves)
-    max_clutter_handle: float = _H.max_clutter_handle  # the same for a cell holding a handle
-    side_cover: float = _H.handle_side_cover     # outline cover of the band on each long side of a handle
-    outline_margin: float = _H.handle_outline_margin  # m: colour blobs this close to the plane's outline are not handles
-    texture_factor: float = _H.texture_factor    # handle/seam thresholds rise to this many times the plane's median response
-    seam_z: float = _H.seam_z                    # a straight seam: the line's median brightness dips this many noise units below its neighbours
-    step_contrast: float = _H.step_contrast      # a colour step along a whole line (a door leaf in a pale wall): colour distance across it ...
-    step_z: float = _H.step_z                    # ... and in noise units of the cell's steps
-    max_depth: int = _H.max_split_depth          # guillotine recursion depth
-    step_over_dip: bool = _H.step_over_dip       # a colour step stronger than the best dark line is the edge
-    outline_step: float = _H.outline_step        # a jump of the covered extent by this share of the cell cuts it first (0: off)
+_U8 = 128.0  # colour ~1 (the plane's mean) -> 128 in 8 bits (medianBlur needs 8 bits), room for highlights
+_U8_MAX = 255  # largest 8-bit value; also the largest kernel medianBlur takes here
+_ACROSS_ROW = np.ones((1, 3), np.uint8)  # a pixel and its left/right neighbours ...
+_ACROSS_COL = np.ones((3, 1), np.uint8)  # ... and its upper/lower ones
+_MIN_LINES = 3  # a profile of fewer usable lines has no seam
 
 
 @dataclass
@@ -80,85 +59,102 @@ class Cell:
     seam_cuts: int = 0  # of those cuts, straight seams along the whole cell (``_dip_cut``)
 
 
-def _valleys(g: np.ndarray, axis: int, contrast: float) -> np.ndarray:
-    """Pixels darker than both neighbours 1-3 px away along ``axis`` by ``contrast``."""
+@dataclass
+class LearnedLines:
+    """Seam evidence from learned line segments (line_evidence.py) as the cell split reads it: pixels on
+    vertical and on horizontal lines that several views support, the share of a cell's length such a line
+    must cover (``lines.span``), and the columns (rows) a vertical (horizontal) learned cut may not take:
+    those of handles running along it. A learned seam may cross a bar handle: a handle never straddles a
+    seam, so a "handle" across one is two bars joined over the gap, or a reflection."""
+
+    vert: np.ndarray
+    horiz: np.ndarray
+    span: float
+    blocked_c: np.ndarray
+    blocked_r: np.ndarray
+
+
+def _valleys(g: np.ndarray, axis: int, contrast: float, width_px: int) -> np.ndarray:
+    """Pixels darker than both neighbours 1 to ``width_px`` px away along ``axis`` by ``contrast``."""
     out = np.zeros(g.shape, bool)
-    for k in (1, 2, 3):
+    for k in range(1, width_px + 1):
         a = np.roll(g, k, axis)
         b = np.roll(g, -k, axis)
         out |= (np.minimum(a, b) - g) > contrast
     return out
 
 
-def _contrast(g: np.ndarray, axis: int, valid: np.ndarray, p: CellParams) -> float:
-    """Valley contrast for seams: ``seam_contrast``, raised on textured planes (wood grain makes thin
+def _contrast(g: np.ndarray, axis: int, valid: np.ndarray, p: SeamConfig, texture_factor: float) -> float:
+    """Valley contrast for seams: ``contrast``, raised on textured planes (wood grain makes thin
     dark lines everywhere) to ``texture_factor`` x the plane's median valley depth."""
     if not valid.any():
-        return p.seam_contrast
+        return p.contrast
     depth = np.maximum(np.minimum(np.roll(g, 2, axis), np.roll(g, -2, axis)) - g, 0.0)
-    return max(p.seam_contrast, 0.5 * p.texture_factor * float(np.median(depth[valid])))
+    return max(p.contrast, 0.5 * texture_factor * float(np.median(depth[valid])))
 
 
-def _gaps(valid: np.ndarray, axis: int) -> np.ndarray:
-    """Unseen pixels with seen pixels on both sides within 3 px along ``axis`` (thin mesh gaps)."""
+def _gaps(valid: np.ndarray, axis: int, width_px: int) -> np.ndarray:
+    """Unseen pixels with seen pixels on both sides within ``width_px`` px along ``axis`` (thin mesh gaps)."""
     out = np.zeros(valid.shape, bool)
-    for k in (1, 2, 3):
+    for k in range(1, width_px + 1):
         a = np.roll(valid, k, axis)
         b = np.roll(valid, -k, axis)
         out |= ~valid & a & b
     return out
 
 
-def seam_maps(o: Orthophoto, p: CellParams) -> tuple[np.ndarray, np.ndarray]:
+def seam_maps(o: Orthophoto, cfg: HeuristicConfig) -> tuple[np.ndarray, np.ndarray]:
     """Boolean maps of vertical-seam and horizontal-seam evidence."""
+    p, tf = cfg.seams, cfg.image.texture_factor
     g = o.color.mean(-1)
     valid = o.n_views > 0
     # smooth along the seam direction only: a seam is a line, noise is not
-    gv = cv2.blur(g, (1, 9))
-    gh = cv2.blur(g, (9, 1))
-    vert = (_valleys(gv, 1, _contrast(gv, 1, valid, p)) & valid) | _gaps(valid, 1)
-    horiz = (_valleys(gh, 0, _contrast(gh, 0, valid, p)) & valid) | _gaps(valid, 0)
+    gv = cv2.blur(g, (1, p.smooth_px))
+    gh = cv2.blur(g, (p.smooth_px, 1))
+    vert = (_valleys(gv, 1, _contrast(gv, 1, valid, p, tf), p.width_px) & valid) | _gaps(valid, 1, p.width_px)
+    horiz = (_valleys(gh, 0, _contrast(gh, 0, valid, p, tf), p.width_px) & valid) | _gaps(valid, 0, p.width_px)
     # a fused seam wobbles by a pixel (residual misregistration): tolerate it across the seam
-    vert = cv2.dilate(vert.astype(np.uint8), np.ones((1, 3), np.uint8)).astype(bool)
-    horiz = cv2.dilate(horiz.astype(np.uint8), np.ones((3, 1), np.uint8)).astype(bool)
+    vert = cv2.dilate(vert.astype(np.uint8), _ACROSS_ROW).astype(bool)
+    horiz = cv2.dilate(horiz.astype(np.uint8), _ACROSS_COL).astype(bool)
     return vert, horiz
 
 
-def off_background(o: Orthophoto, p: CellParams) -> np.ndarray:
+def off_background(o: Orthophoto, h: HandleConfig) -> np.ndarray:
     """Colour distance of every pixel from its local background (median over ``background_win``)."""
     valid = o.n_views > 0
     if not valid.any():
         return np.zeros(valid.shape, np.float32)
-    c = np.clip(o.color * 128, 0, 255).astype(np.uint8)
+    c = np.clip(o.color * _U8, 0, _U8_MAX).astype(np.uint8)
     c[~valid] = np.median(c[valid], axis=0).astype(np.uint8)  # unseen pixels must not look like blobs
-    k = min(max(3, int(p.background_win / o.res) | 1), 255)
+    k = min(max(MIN_KERNEL, int(h.background_win / o.res) | 1), _U8_MAX)
     # mirrored, not replicated, beyond the orthophoto's border: medianBlur repeats the last row, so a dark
     # band along a wall cabinet's bottom edge filled half the window of a flap's handle 5 cm above it
     # and the bar matched its "background"
     r = k // 2
     bg = cv2.medianBlur(cv2.copyMakeBorder(c, r, r, r, r, cv2.BORDER_REFLECT_101), k)[r:-r, r:-r]
-    return np.linalg.norm(c.astype(np.float32) - bg.astype(np.float32), axis=-1) / 128.0
+    return np.linalg.norm(c.astype(np.float32) - bg.astype(np.float32), axis=-1) / _U8
 
 
-def off_threshold(diff: np.ndarray, valid: np.ndarray, p: CellParams) -> float:
-    """Colour distance above which a pixel is off its background: ``handle_contrast``, raised on
-    textured planes (wood grain deviates everywhere) to ``texture_factor`` x the plane's median."""
+def off_threshold(diff: np.ndarray, valid: np.ndarray, cfg: HeuristicConfig) -> float:
+    """Colour distance above which a pixel is off its background: ``handles.contrast``, raised on
+    textured planes (wood grain deviates everywhere) to ``image.texture_factor`` x the plane's median."""
     if not valid.any():
-        return p.handle_contrast
-    return max(p.handle_contrast, p.texture_factor * float(np.median(diff[valid])))
+        return cfg.handles.contrast
+    return max(cfg.handles.contrast, cfg.image.texture_factor * float(np.median(diff[valid])))
 
 
-def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.ndarray | None = None,
+def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff: np.ndarray | None = None,
                  protrusion: np.ndarray | None = None, outline: np.ndarray | None = None) -> list[Handle]:
     """Compact elongated blobs whose colour differs from the local background (see module docstring).
-    Colour blobs keep ``outline_margin`` inside ``coverage`` (colour beside a scanning shadow is
+    Colour blobs keep ``handles.outline_margin`` inside ``coverage`` (colour beside a scanning shadow is
     misregistered); a handle must lie inside ``outline`` (coverage with handle shadows filled; default
     ``coverage``)."""
+    p = cfg.handles
     valid = o.n_views > 0
-    if valid.sum() < 100:
+    if valid.sum() < p.min_seen_px:
         return []
     diff = off_background(o, p) if diff is None else diff
-    thr = off_threshold(diff, valid, p)
+    thr = off_threshold(diff, valid, cfg)
     # the plane's own outline (a worktop edge's shadow, the floor line) is no handle: keep 2 cm away
     edge = max(1, int(round(p.outline_margin / o.res)))
     inner = cv2.erode(coverage.astype(np.uint8), np.ones((2 * edge + 1, 2 * edge + 1), np.uint8)).astype(bool)
@@ -167,29 +163,29 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, p: CellParams, diff: np.nd
     bar = np.zeros_like(colour) if protrusion is None else protrusion.astype(np.uint8)
     blob = colour | bar
     # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
-    L = int(p.handle_len[1] / o.res) + 1
+    L = int(p.length[1] / o.res) + 1
     strips = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((1, L), np.uint8)) | \
         cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
-    keep = 1 - cv2.dilate(strips, np.ones((3, 3), np.uint8))
+    keep = 1 - cv2.dilate(strips, NEIGHBOURS)
     # the opening cuts 1-2 px grain bridges in the colour; a bar in the mesh is no grain and, 3-4 px wide
     # at 4 mm, would fall apart under it
-    blob = cv2.morphologyEx(colour & keep, cv2.MORPH_OPEN, np.ones((3, 3), np.uint8)) | (bar & keep)
-    g = max(3, int(0.03 / o.res) | 1)  # a bar broken by a highlight is one handle
+    blob = cv2.morphologyEx(colour & keep, cv2.MORPH_OPEN, NEIGHBOURS) | (bar & keep)
+    g = max(MIN_KERNEL, int(p.join_gap / o.res) | 1)  # a bar broken by a highlight is one handle
     blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=8)
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=CONNECTIVITY)
     out = []
     for j in range(1, n):
         x, y, w, h, area = stats[j]
         long_, short = max(w, h) * o.res, min(w, h) * o.res
-        if not (p.handle_len[0] <= long_ <= p.handle_len[1] and p.handle_thick[0] <= short <= p.handle_thick[1]):
+        if not (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]):
             continue
-        if max(w, h) < p.handle_aspect * min(w, h) or area < 0.4 * w * h:
+        if max(w, h) < p.aspect * min(w, h) or area < p.min_fill * w * h:
             continue
         # a handle sits on the front: mesh coverage around it on both sides across its length
-        pad = max(2, int(0.02 / o.res))
+        pad = max(2, int(p.side_band / o.res))
         r0, r1, c0, c1 = max(0, y - pad), min(lab.shape[0], y + h + pad), max(0, x - pad), min(lab.shape[1], x + w + pad)
         ref = coverage if outline is None else outline
-        if ref[r0:r1, c0:c1].mean() < 0.4:
+        if ref[r0:r1, c0:c1].mean() < p.around_cover:
             continue
         if p.side_cover > 0 and min(_side_cover(ref, (x, y, w, h), pad)) < p.side_cover:
             continue
@@ -212,14 +208,18 @@ def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int) -> tu
     return float(bands[0].sum()) / full, float(bands[1].sum()) / full
 
 
-def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], p: CellParams) -> list[Cell]:
-    """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs."""
+def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg: HeuristicConfig,
+                lines: tuple[np.ndarray, np.ndarray] | None = None) -> list[Cell]:
+    """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs.
+    ``lines``: pixels on vertical and on horizontal lines that learned line segments of several views
+    support (line_evidence.py; ``perception.heuristic.lines``), a seam where the brightness shows none."""
     rows, cols = np.nonzero(coverage)
     if not len(rows):
         return []
-    vert, horiz = seam_maps(o, p)
+    p, cells_cfg = cfg.seams, cfg.cells
+    vert, horiz = seam_maps(o, cfg)
     root = Cell(int(cols.min()), int(rows.min()), int(cols.max()) + 1, int(rows.max()) + 1)
-    min_px = max(2, int(p.min_front / o.res))
+    min_px = max(2, int(cells_cfg.min_side / o.res))
     blocked_c = np.zeros(coverage.shape[1], bool)  # no cut runs through a handle
     blocked_r = np.zeros(coverage.shape[0], bool)
     for h in handles:
@@ -227,12 +227,27 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], p: C
         blocked_r[h.box[1]:h.box[3]] = True
     col = np.where((o.n_views > 0)[..., None], o.color, np.nan)  # unseen pixels carry no colour
     g = col.mean(-1)
-    cells = _split(root, vert, horiz, coverage, p, min_px, 0, blocked_c, blocked_r, handles, g, col)
+    learned = None
+    if lines is not None:
+        along_c = np.zeros(coverage.shape[1], bool)  # columns of vertical handles, rows of horizontal ones
+        along_r = np.zeros(coverage.shape[0], bool)
+        for h in handles:
+            if h.horizontal:
+                along_r[h.box[1]:h.box[3]] = True
+            else:
+                along_c[h.box[0]:h.box[2]] = True
+        learned = LearnedLines(lines[0], lines[1], cfg.lines.span, along_c, along_r)
+    cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, g, col, learned)
     for c in cells:
         c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
+    held = {id(h) for c in cells for h in c.handles}
+    for h in handles:  # centred on a learned cut through it (the cut line is in no cell): the nearest cell
+        if id(h) not in held and cells:
+            x, y = h.center
+            min(cells, key=lambda c: np.hypot(max(c.c0 - x, 0.0, x - c.c1), max(c.r0 - y, 0.0, y - c.r1))).handles.append(h)
     out: list[Cell] = []
     for c in cells:
-        out += _split_handles(c, vert, horiz, coverage, min_px, g, p)
+        out += _split_handles(c, vert, horiz, coverage, min_px, g, p, learned)
     return out
 
 
@@ -240,32 +255,32 @@ def _profile(ev: np.ndarray, cov: np.ndarray, axis: int, chunks: int = 1) -> np.
     """Fraction of covered pixels along ``axis`` that carry seam evidence, per line across it; with
     ``chunks`` > 1 the smallest such fraction over that many equal pieces of the line (a seam runs the
     whole length; a row of handles or a patch of noise does not)."""
-    if chunks > 1 and ev.shape[axis] >= 3 * chunks:
+    if chunks > 1 and ev.shape[axis] >= _MIN_LINES * chunks:
         parts = zip(np.array_split(ev, chunks, axis), np.array_split(cov, chunks, axis))
         return np.min([_profile(e, c, axis) for e, c in parts], axis=0)
     n = cov.sum(axis)
     return np.where(n > 0, (ev & cov).sum(axis) / np.maximum(n, 1), 0.0)
 
 
-def _best_cut(ev: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams,
+def _best_cut(ev: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamConfig,
               blocked: np.ndarray) -> tuple[int, float]:
     """Best split line (index in the cell, prominence) keeping ``min_px`` on each side; lines covering
-    less than ``seam_span`` of the cell score 0."""
+    less than ``span`` of the cell (or half of it in any of ``span_chunks`` pieces) score 0."""
     prof = _profile(ev, cov, axis)
     if len(prof) <= 2 * min_px:
         return -1, 0.0
     prom = prof - ndimage.median_filter(prof, size=2 * min_px + 1, mode="nearest")
-    prom = np.where((prof >= p.seam_span) & (_profile(ev, cov, axis, 3) >= 0.5 * p.seam_span) & ~blocked, prom, 0.0)
+    prom = np.where((prof >= p.span) & (_profile(ev, cov, axis, p.span_chunks) >= 0.5 * p.span) & ~blocked, prom, 0.0)
     inner = prom[min_px:len(prof) - min_px]
     i = int(np.argmax(inner))
     return i + min_px, float(inner[i])
 
 
-def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams) -> np.ndarray:
+def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamConfig) -> np.ndarray:
     """Per line across ``axis``: how far its median brightness dips below the lines beside it (within
     ``min_px``), in noise units. A seam is a straight dark line along the whole cell, so the median over
     the line dips, while wood grain, noise and reflections wander and average out (boolean valley counts
-    saturate on strongly grained fronts). Lines less than 30 % covered score 0."""
+    saturate on strongly grained fronts). Lines covered less than ``min_line_cover`` score 0."""
     cov = cov & np.isfinite(g)
     n = cov.sum(axis)
     if not n.any():
@@ -273,16 +288,16 @@ def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellP
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN lines are handled below
         prof = np.nanmedian(np.where(cov, g, np.nan), axis)
-    ok = (n >= 0.3 * n.max()) & np.isfinite(prof)
-    if ok.sum() < 3:
+    ok = (n >= p.min_line_cover * n.max()) & np.isfinite(prof)
+    if ok.sum() < _MIN_LINES:
         return np.zeros(len(n))
     prof = np.where(ok, prof, np.median(prof[ok]))
     dip = ndimage.median_filter(prof, size=2 * min_px + 1, mode="nearest") - prof
-    noise = max(1.4826 * float(np.median(np.abs(dip[ok] - np.median(dip[ok])))), 1e-3)
-    return np.where(ok & (dip >= p.seam_contrast), dip / noise, 0.0)
+    noise = max(MAD_SIGMA * float(np.median(np.abs(dip[ok] - np.median(dip[ok])))), p.noise_floor)
+    return np.where(ok & (dip >= p.contrast), dip / noise, 0.0)
 
 
-def _step_scores(c: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams) -> np.ndarray:
+def _step_scores(c: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamConfig) -> np.ndarray:
     """Per line across ``axis``: the colour step between the ``k`` lines before and after it (median
     colour per line, k = min_px / 2), where it is at least ``step_contrast``, in noise units. A front of
     another colour than what surrounds it (a brown door leaf in a pale wall) has no dark seam, only a
@@ -293,25 +308,25 @@ def _step_scores(c: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: Cell
         return np.zeros(len(n))
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        prof = np.stack([np.nanmedian(np.where(seen, c[..., j], np.nan), axis) for j in range(3)], 1)
-    ok = (n >= 0.3 * n.max()) & np.isfinite(prof[:, 0])
-    if ok.sum() < 3:
+        prof = np.stack([np.nanmedian(np.where(seen, c[..., j], np.nan), axis) for j in range(RGB)], 1)
+    ok = (n >= p.min_line_cover * n.max()) & np.isfinite(prof[:, 0])
+    if ok.sum() < _MIN_LINES:
         return np.zeros(len(n))
     idx = np.arange(len(n))
-    prof = np.stack([np.interp(idx, idx[ok], prof[ok, j]) for j in range(3)], 1)
+    prof = np.stack([np.interp(idx, idx[ok], prof[ok, j]) for j in range(RGB)], 1)
     k = max(2, min_px // 2)
-    cs = np.vstack([np.zeros((1, 3)), np.cumsum(prof, 0)])
+    cs = np.vstack([np.zeros((1, RGB)), np.cumsum(prof, 0)])
     lo = np.clip(idx - k, 0, None)
     hi = np.clip(idx + 1 + k, None, len(n))
     before = (cs[idx] - cs[lo]) / np.maximum(idx - lo, 1)[:, None]
     after = (cs[hi] - cs[idx + 1]) / np.maximum(hi - idx - 1, 1)[:, None]
     step = np.linalg.norm(after - before, axis=1)
     step[(idx - lo < k) | (hi - idx - 1 < k)] = 0.0
-    noise = max(1.4826 * float(np.median(np.abs(step[ok] - np.median(step[ok])))), 1e-3)
+    noise = max(MAD_SIGMA * float(np.median(np.abs(step[ok] - np.median(step[ok])))), p.noise_floor)
     return np.where(ok & (step >= p.step_contrast), step / noise, 0.0)
 
 
-def _dip_cut(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: CellParams,
+def _dip_cut(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamConfig,
              blocked: np.ndarray, scores: Callable = _dip_scores) -> tuple[int, float]:
     """Best split line by ``scores`` (``_dip_scores`` or ``_step_scores``; index in the cell, score),
     keeping ``min_px`` on each side and off ``blocked`` lines."""
@@ -350,32 +365,57 @@ def _outline_cut(cov: np.ndarray, axis: int, min_px: int, blocked: np.ndarray) -
     return cut, float(jump[i])
 
 
-def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: CellParams, min_px: int,
+def _line_cut(ev: np.ndarray, cov: np.ndarray, axis: int, min_px: int, span: float, chunks: int,
+              blocked: np.ndarray) -> tuple[int, float]:
+    """Best split line on learned line evidence ``ev`` (index in the cell, share of the cell's covered
+    length it covers), keeping ``min_px`` on each side and off ``blocked`` lines; lines covering less than
+    ``span`` (or half of it in any of ``chunks`` pieces) score 0."""
+    prof = _profile(ev, cov, axis)
+    if len(prof) <= 2 * min_px:
+        return -1, 0.0
+    ok = (prof >= span) & (_profile(ev, cov, axis, chunks) >= 0.5 * span) & ~blocked
+    inner = np.where(ok, prof, 0.0)[min_px:len(prof) - min_px]
+    i = _plateau_middle(inner)
+    return i + min_px, float(inner[i])
+
+
+def _plateau_middle(v: np.ndarray) -> int:
+    """Index of the middle of the run of equal values around ``v``'s first maximum: a line drawn a few px
+    wide (learned segments widened by ``lines.tol``) is cut at its centre, not its edge."""
+    i = int(np.argmax(v))
+    j = i
+    while j + 1 < len(v) and v[j + 1] == v[i]:
+        j += 1
+    return (i + j) // 2
+
+
+def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: SeamConfig, q: CellConfig, min_px: int,
            depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray,
-           col: np.ndarray) -> list[Cell]:
-    """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at the most
-    prominent seam by valley counts. Inside a cell holding handles, a horizontal cut must leave a handle
-    on both sides (glossy fronts reflect horizontal table and shelf edges at a constant height; a drawer
-    above a door carries its own handle)."""
-    if depth >= p.max_depth:
+           col: np.ndarray, learned: LearnedLines | None = None) -> list[Cell]:
+    """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at a line that
+    ``learned`` line segments support, else at the most prominent seam by valley counts.
+    Inside a cell holding handles, a horizontal cut must leave a handle on both sides (glossy fronts
+    reflect horizontal table and shelf edges at a constant height; a drawer above a door carries its own
+    handle)."""
+    if depth >= q.max_split_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
-    if p.outline_step > 0:  # an L-shaped outline splits at its corner before any seam is sought
+    if q.outline_step > 0:  # an L-shaped outline splits at its corner before any seam is sought
         ov, sv = _outline_cut(cov[sl], 0, min_px, bc[c.c0:c.c1])
         oh, sh = _outline_cut(cov[sl], 1, min_px, br[c.r0:c.r1])
-        if max(sv, sh) >= p.outline_step:  # columns first: a run splits into units, a unit into fronts
-            if sv >= p.outline_step:
+        if max(sv, sh) >= q.outline_step:  # columns first: a run splits into units, a unit into fronts
+            if sv >= q.outline_step:
                 a = Cell(c.c0, c.r0, c.c0 + ov, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
                 b = Cell(c.c0 + ov + 1, c.r0, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
             else:
                 a = Cell(c.c0, c.r0, c.c1, c.r0 + oh, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
                 b = Cell(c.c0, c.r0 + oh + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
-            return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, handles, g, col)
-                    + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, handles, g, col))
+            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned)
+                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned))
     cv_, sc_v = _dip_cut(g[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
     ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
-    sc_v = sc_v if sc_v >= p.seam_z else 0.0
-    sc_h = sc_h if sc_h >= p.seam_z else 0.0
+    sc_v = sc_v if sc_v >= p.dip_z else 0.0
+    sc_h = sc_h if sc_h >= p.dip_z else 0.0
     dip_v, dip_h = sc_v > 0.0, sc_h > 0.0
     if p.step_over_dip or not (dip_v or dip_h):
         # a colour step along the whole cell (a front of another colour than its surround or its
@@ -390,11 +430,19 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
         if st_h > sc_h:
             ch_, sc_h, dip_h = sh_, st_h, False
     straight = int(dip_v if sc_v >= sc_h else dip_h) if max(sc_v, sc_h) > 0.0 else 0
+    if max(sc_v, sc_h) == 0.0 and learned is not None:
+        # a straight line that the learned segments of several views agree on (a seam in a glossy or
+        # evenly lit front shows no dark line)
+        cv_, sc_v = _line_cut(learned.vert[sl], cov[sl], 0, min_px, learned.span, p.span_chunks,
+                              learned.blocked_c[c.c0:c.c1])
+        ch_, sc_h = _line_cut(learned.horiz[sl], cov[sl], 1, min_px, learned.span, p.span_chunks,
+                              learned.blocked_r[c.r0:c.r1])
+        straight = int(max(sc_v, sc_h) > 0.0)
     if max(sc_v, sc_h) == 0.0:
         cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])
         ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
-        sc_v = sc_v if sc_v >= p.seam_prominence else 0.0
-        sc_h = sc_h if sc_h >= p.seam_prominence_h else 0.0
+        sc_v = sc_v if sc_v >= p.prominence else 0.0
+        sc_h = sc_h if sc_h >= p.prominence_h else 0.0
     mine = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     if sc_h and mine:
         cut = c.r0 + ch_
@@ -409,25 +457,32 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Cel
     else:
         a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=n, seam_cuts=k)
         b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=n, seam_cuts=k)
-    return (_split(a, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g, col)
-            + _split(b, vert, horiz, cov, p, min_px, depth + 1, bc, br, mine, g, col))
+    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned)
+            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned))
 
 
-def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: CellParams) -> int:
-    """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the strongest straight
-    seam (``_dip_scores`` ≥ 3 noise units), else the most seam-like line by valley counts, else the middle."""
+def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: SeamConfig,
+             learned: np.ndarray | None = None, span: float = 1.0) -> int:
+    """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the line ``learned`` line
+    evidence covers most, when it covers at least ``span`` of the cell; else the strongest straight seam
+    (``_dip_scores`` >= ``between_z`` noise units), else the most seam-like line by valley counts
+    (covering more than ``between_span``), else the middle."""
     if hi - lo < 1:
         return (lo + hi) // 2
+    if learned is not None:
+        prof = _profile(learned, cov, axis)[lo:hi]
+        if prof.max() >= span:
+            return lo + _plateau_middle(prof)
     z = _dip_scores(g, cov, axis, min_px, p)[lo:hi]
-    if z.max() >= 3.0:
+    if z.max() >= p.between_z:
         return lo + int(np.argmax(z))
     sl = (slice(None), slice(lo, hi)) if axis == 0 else (slice(lo, hi), slice(None))
     prof = _profile(ev[sl], cov[sl], axis)
-    return lo + int(np.argmax(prof)) if prof.max() > 0.2 else (lo + hi) // 2
+    return lo + int(np.argmax(prof)) if prof.max() > p.between_span else (lo + hi) // 2
 
 
 def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: np.ndarray,
-                   p: CellParams) -> list[Cell]:
+                   p: SeamConfig, learned: LearnedLines | None = None) -> list[Cell]:
     """Split a cell between consecutive handles (side by side: at the best column between them;
     stacked: at the best row), recursively, so every cell ends with at most one handle per row/column."""
     if len(c.handles) < 2:
@@ -445,7 +500,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         if hi - lo < 2:
             lo, hi = int(xs[k]), int(xs[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
-        cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p)
+        cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
+                              None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span)
         a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):
@@ -458,9 +514,11 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         if hi - lo < 2:
             lo, hi = int(ys[k]), int(ys[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
-        cut = c.r0 + _between(g[rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p)
+        cut = c.r0 + _between(g[rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p,
+                              None if learned is None else learned.horiz[rs, cs], 1.0 if learned is None else learned.span)
         a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1):
             return [c]
-    return _split_handles(a, vert, horiz, cov, min_px, g, p) + _split_handles(b, vert, horiz, cov, min_px, g, p)
+    return (_split_handles(a, vert, horiz, cov, min_px, g, p, learned)
+            + _split_handles(b, vert, horiz, cov, min_px, g, p, learned))

@@ -23,7 +23,7 @@ from ...geometry import horizontal_right
 from .facets import Facets
 
 
-FrontRules = FrontRulesConfig  # the rules are the config section perception.heuristic.fronts (descriptions there)
+_OPENING_PROBE = 0.1  # rad: a small opening, only to tell which way the axis turns the front out
 
 
 @dataclass
@@ -60,7 +60,7 @@ def _frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: np.ndarray,
-                rules: FrontRules = FrontRules(), glimpsed: np.ndarray | None = None,
+                rules: FrontRulesConfig = FrontRulesConfig(), glimpsed: np.ndarray | None = None,
                 view_dirs: np.ndarray | None = None) -> list[Front]:
     """Fronts among facets with ``visible[facet]`` True.
 
@@ -72,7 +72,7 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
     order = np.argsort(facets.labels, kind="stable")
     starts = np.searchsorted(facets.labels[order], np.arange(facets.n + 1))
     faces_of = lambda k: order[starts[k]:starts[k + 1]]  # noqa: E731
-    fa = np.zeros((facets.n, 3))
+    fa = np.zeros((facets.n, fc.shape[1]))
     np.add.at(fa, facets.labels, fc * mesh.face_areas[:, None])
     fcent = fa / np.maximum(facets.areas, 1e-15)[:, None]
 
@@ -84,20 +84,20 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
         if np.dot(n, toward) < 0:
             n = -n
         nh, u = _frame(n)
-        pts = fv[faces_of(k)].reshape(-1, 3)
+        pts = fv[faces_of(k)].reshape(-1, fv.shape[-1])
         pu, pv = pts @ u, pts[:, 2]
         eu, ev = (float(pu.min()), float(pu.max())), (float(pv.min()), float(pv.max()))
         w, h = eu[1] - eu[0], ev[1] - ev[0]
         if not (rules.min_w <= w <= rules.max_w and rules.min_h <= h <= rules.max_h):
             continue
         if facets.areas[k] < rules.min_fill * w * h:
-            if facets.areas[k] >= 0.15 * w * h:
+            if facets.areas[k] >= rules.ring_min_fill * w * h:
                 rings.append(Front(int(k), [], fcent[k], nh, u, eu, ev))
             continue
         cands.append(Front(int(k), [], fcent[k], nh, u, eu, ev))
     if not cands and not rings:
         return []
-    cands = _drop_covered(cands)
+    cands = _drop_covered(cands, rules)
     _absorb_frames(cands, facets, fv, fcent, faces_of, visible, rules)
     cands += _ring_fronts(cands, rings, facets, fv, fcent, faces_of, visible, rules)
     if not cands:
@@ -116,9 +116,10 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
         ev = np.array([f.extent_v for f in cands])
         d = np.einsum("scx,cx->sc", c[:, None, :] - centers[None], normals)   # depth in front of each plane
         cu, cv = c @ us.T, c[:, 2:3]
-        facing = facets.normals[small] @ normals.T > -0.3  # a facet facing back at the front is another object's
+        facing = facets.normals[small] @ normals.T > rules.handle_min_cos  # a facet facing back at the front is another object's
+        s = rules.rect_slack
         ok = (facing & (rules.handle_depth[0] < d) & (d < rules.handle_depth[1])
-              & (eu[:, 0] + 0.005 < cu) & (cu < eu[:, 1] - 0.005) & (ev[:, 0] + 0.005 < cv) & (cv < ev[:, 1] - 0.005))
+              & (eu[:, 0] + s < cu) & (cu < eu[:, 1] - s) & (ev[:, 0] + s < cv) & (cv < ev[:, 1] - s))
         d = np.where(ok, d, np.inf)
         best = d.argmin(1)
         for s_id, k in zip(small[np.isfinite(d.min(1))], best[np.isfinite(d.min(1))]):
@@ -130,7 +131,7 @@ def find_fronts(mesh: TriMesh, facets: Facets, visible: np.ndarray, cam_center: 
             continue  # a lone plain panel (a cabinet side, a wall piece): not openable by these rules
         hf = np.concatenate([faces_of(s) for s in f.handle_facets]) if f.handle_facets else np.zeros(0, np.int64)
         f.faces = np.concatenate([faces_of(k) for k in [f.facet, *f.frame_facets]] + [hf])
-        hpts = fv[hf].reshape(-1, 3) if len(hf) else None
+        hpts = fv[hf].reshape(-1, fv.shape[-1]) if len(hf) else None
         f.kind, f.articulation = _joint(f, hpts, neighbours, rules)
         out.append(f)
     _add_rims(out, facets, fv, fcent, faces_of, visible if glimpsed is None else glimpsed, rules)
@@ -157,7 +158,7 @@ def _gap(f: Front, rect: tuple[float, float, float, float]) -> float:
 
 
 def _absorb_frames(cands: list[Front], facets: Facets, fv: np.ndarray, fcent: np.ndarray, faces_of, visible: np.ndarray,  # noqa: ANN001
-                   r: FrontRules) -> None:
+                   r: FrontRulesConfig) -> None:
     """Frame-and-panel fronts (shaker doors, oven doors around a window): grow a panel candidate by the
     frame pieces around it — vertical facets facing the same way, a few mm to 3 cm in front of a
     recessed panel or 3-16 mm behind a raised one (a carcass around an inset door is level with it, one
@@ -170,18 +171,18 @@ def _absorb_frames(cands: list[Front], facets: Facets, fv: np.ndarray, fcent: np
     taken = np.zeros(facets.n, bool)
     taken[[f.facet for f in cands]] = True
     vert = visible & (np.abs(facets.normals[:, 2]) <= r.max_tilt) & ~taken
-    m, t = r.frame_max_width, 0.015
+    m, t = r.frame_max_width, r.frame_max_gap
     plans: dict[int, list[tuple[int, float, float, float, float]]] = {}
     claims: dict[int, list[tuple[float, int]]] = {}
     for ci, f in enumerate(cands):
         d = (fcent - f.center) @ f.n_out
         cu, cv = fcent @ f.u, fcent[:, 2]
-        near = (vert & (np.abs(facets.normals @ f.n_out) >= 0.97) & (((d > r.frame_depth[0]) & (d < r.frame_depth[1])) | ((d > r.raised_depth[0]) & (d < r.raised_depth[1])))
+        near = (vert & (np.abs(facets.normals @ f.n_out) >= r.parallel_cos) & (((d > r.frame_depth[0]) & (d < r.frame_depth[1])) | ((d > r.raised_depth[0]) & (d < r.raised_depth[1])))
                 & (cu > f.extent_u[0] - m) & (cu < f.extent_u[1] + m) & (cv > f.extent_v[0] - m) & (cv < f.extent_v[1] + m))
         pieces = []
         for k in np.flatnonzero(near):
-            rect = _facet_rect(fv[faces_of(k)].reshape(-1, 3), f)
-            if _within(f, rect, m + 0.005) and _gap(f, rect) <= t:
+            rect = _facet_rect(fv[faces_of(k)].reshape(-1, fv.shape[-1]), f)
+            if _within(f, rect, m + r.rect_slack) and _gap(f, rect) <= t:
                 pieces.append((int(k), *rect))
         if _frame_rect(f, pieces, facets, r) is None:
             continue
@@ -191,7 +192,7 @@ def _absorb_frames(cands: list[Front], facets: Facets, fv: np.ndarray, fcent: np
     owner = {}
     for k, cl in claims.items():
         cl.sort()
-        if len(cl) == 1 or cl[1][0] - cl[0][0] > 0.003:
+        if len(cl) == 1 or cl[1][0] - cl[0][0] > r.frame_claim_margin:
             owner[k] = cl[0][1]
     for ci, pieces in plans.items():
         pieces = [p_ for p_ in pieces if owner.get(p_[0]) == ci]
@@ -209,7 +210,7 @@ def _absorb_frames(cands: list[Front], facets: Facets, fv: np.ndarray, fcent: np
 
 
 def _ring_fronts(cands: list[Front], rings: list[Front], facets: Facets, fv: np.ndarray, fcent: np.ndarray, faces_of,  # noqa: ANN001
-                 visible: np.ndarray, r: FrontRules) -> list[Front]:
+                 visible: np.ndarray, r: FrontRulesConfig) -> list[Front]:
     """Frame-and-panel fronts whose panel is too small to be a front itself (a 13 cm drawer with an
     8 cm panel): a ring-shaped facet whose hole is filled by free facets facing the same way — a
     panel recessed behind it or raised in front of it — becomes a front."""
@@ -222,12 +223,12 @@ def _ring_fronts(cands: list[Front], rings: list[Front], facets: Facets, fv: np.
             continue
         d = (fcent - g.center) @ g.n_out
         cu, cv = fcent @ g.u, fcent[:, 2]
-        near = np.flatnonzero(visible & ~taken & (np.abs(facets.normals @ g.n_out) >= 0.97)
+        near = np.flatnonzero(visible & ~taken & (np.abs(facets.normals @ g.n_out) >= r.parallel_cos)
                               & (((d > -r.frame_depth[1]) & (d < -r.frame_depth[0])) | ((d > -r.raised_depth[1]) & (d < -r.raised_depth[0])))
                               & (cu > g.extent_u[0]) & (cu < g.extent_u[1]) & (cv > g.extent_v[0]) & (cv < g.extent_v[1]))
         ks = []
         for k in near:
-            if _within(g, _facet_rect(fv[faces_of(k)].reshape(-1, 3), g), 0.005):
+            if _within(g, _facet_rect(fv[faces_of(k)].reshape(-1, fv.shape[-1]), g), r.rect_slack):
                 ks.append(int(k))
         if ks and facets.areas[g.facet] + facets.areas[ks].sum() >= r.min_fill * g.w * g.h:
             g.frame_facets = ks
@@ -237,9 +238,9 @@ def _ring_fronts(cands: list[Front], rings: list[Front], facets: Facets, fv: np.
 
 
 def _frame_rect(f: Front, pieces: list[tuple[int, float, float, float, float]], facets: Facets,
-                r: FrontRules) -> tuple[tuple[float, float], tuple[float, float]] | None:
+                r: FrontRulesConfig) -> tuple[tuple[float, float], tuple[float, float]] | None:
     """Outer rectangle of panel + frame pieces when they form a frame-and-panel front, else None."""
-    if len(_sides(f, pieces)) < 3:
+    if len(_sides(f, pieces, r.rect_slack)) < r.frame_min_sides:
         return None  # a frame surrounds its panel; a single rail next to a front is the carcass
     eu = (min([f.extent_u[0]] + [p[1] for p in pieces]), max([f.extent_u[1]] + [p[2] for p in pieces]))
     ev = (min([f.extent_v[0]] + [p[3] for p in pieces]), max([f.extent_v[1]] + [p[4] for p in pieces]))
@@ -247,27 +248,27 @@ def _frame_rect(f: Front, pieces: list[tuple[int, float, float, float, float]], 
     area = facets.areas[f.facet] + sum(facets.areas[p[0]] for p in pieces)
     if not (r.min_w <= w <= r.max_w and r.min_h <= h <= r.max_h) or area < r.min_fill * w * h:
         return None
-    if facets.areas[f.facet] > 0.85 * w * h:
+    if facets.areas[f.facet] > r.frame_panel_max_fill * w * h:
         return None  # only slivers around a plain front: nothing to absorb
     return eu, ev
 
 
-def _sides(f: Front, pieces: list[tuple[int, float, float, float, float]]) -> set[str]:
-    """Which sides of ``f`` the pieces border (beyond the edge, overlapping it by half its length)."""
+def _sides(f: Front, pieces: list[tuple[int, float, float, float, float]], slack: float) -> set[str]:
+    """Which sides of ``f`` the pieces border (``slack`` beyond the edge, overlapping it by half its length)."""
     out = set()
     (a0, a1), (b0, b1) = f.extent_u, f.extent_v
     for _, u0, u1, v0, v1 in pieces:
         ov_v = min(v1, b1) - max(v0, b0) >= 0.5 * (b1 - b0)
         ov_u = min(u1, a1) - max(u0, a0) >= 0.5 * (a1 - a0)
-        out |= {s for s, ok in (("left", u0 < a0 - 0.005 and ov_v), ("right", u1 > a1 + 0.005 and ov_v),
-                                ("bottom", v0 < b0 - 0.005 and ov_u), ("top", v1 > b1 + 0.005 and ov_u)) if ok}
+        out |= {s for s, ok in (("left", u0 < a0 - slack and ov_v), ("right", u1 > a1 + slack and ov_v),
+                                ("bottom", v0 < b0 - slack and ov_u), ("top", v1 > b1 + slack and ov_u)) if ok}
     return out
 
 
 def _add_rims(fronts: list[Front], facets: Facets, fv: np.ndarray, fcent: np.ndarray, faces_of, glimpsed: np.ndarray,  # noqa: ANN001
-              r: FrontRules) -> None:
+              r: FrontRulesConfig) -> None:
     """Add a front's own edges and bevels: small facets glimpsed by the cameras that lie inside its
-    rectangle (± ``rim_margin``) between ``rim_depth`` behind its plane and 1 cm in front, not part of
+    rectangle (± ``rim_margin``) between ``rim_depth`` behind its plane and ``rim_front`` in front, not part of
     another front; a facet that fits several fronts goes to the one whose rectangle holds its centre deepest."""
     if not fronts:
         return
@@ -284,11 +285,11 @@ def _add_rims(fronts: list[Front], facets: Facets, fv: np.ndarray, fcent: np.nda
         d = (fcent[free] - f.center) @ f.n_out
         cu, cv = fcent[free] @ f.u, fcent[free, 2]
         inset = np.minimum.reduce([cu - f.extent_u[0], f.extent_u[1] - cu, cv - f.extent_v[0], f.extent_v[1] - cv])
-        cand = np.flatnonzero((d > -r.rim_depth) & (d < 0.01) & (inset > -m) & (inset > best))
+        cand = np.flatnonzero((d > -r.rim_depth) & (d < r.rim_front) & (inset > -m) & (inset > best))
         for j in cand:
-            pts = fv[faces_of(free[j])].reshape(-1, 3)
+            pts = fv[faces_of(free[j])].reshape(-1, fv.shape[-1])
             dd = (pts - f.center) @ f.n_out
-            if _within(f, _facet_rect(pts, f), m) and dd.min() > -r.rim_depth and dd.max() < 0.01:
+            if _within(f, _facet_rect(pts, f), m) and dd.min() > -r.rim_depth and dd.max() < r.rim_front:
                 best[j], owner[j] = inset[j], i
     for i, f in enumerate(fronts):
         ks = free[owner == i]
@@ -296,13 +297,14 @@ def _add_rims(fronts: list[Front], facets: Facets, fv: np.ndarray, fcent: np.nda
             f.faces = np.concatenate([f.faces, *[faces_of(k) for k in ks]])
 
 
-def _drop_covered(cands: list[Front]) -> list[Front]:
+def _drop_covered(cands: list[Front], r: FrontRulesConfig) -> list[Front]:
     """Drop a facet that other candidates cover from the front (a carcass face seen through the gaps)."""
     keep = []
     for f in cands:
         covered = 0.0
         for g in cands:
-            if g is f or np.dot(g.n_out, f.n_out) < 0.97 or not (0.001 < np.dot(g.center - f.center, f.n_out) < 0.08):
+            if (g is f or np.dot(g.n_out, f.n_out) < r.parallel_cos
+                    or not (r.cover_depth[0] < np.dot(g.center - f.center, f.n_out) < r.cover_depth[1])):
                 continue
             gu0, gu1 = float(g.center @ f.u) - g.w / 2, float(g.center @ f.u) + g.w / 2
             ou = max(0.0, min(gu1, f.extent_u[1]) - max(gu0, f.extent_u[0]))
@@ -313,15 +315,16 @@ def _drop_covered(cands: list[Front]) -> list[Front]:
     return keep
 
 
-def _neighbours(f: Front, cands: list[Front], r: FrontRules) -> list[tuple[Front, str]]:
+def _neighbours(f: Front, cands: list[Front], r: FrontRulesConfig) -> list[tuple[Front, str]]:
     """Coplanar candidates touching ``f`` on its left/right (same height) or above/below (same width)."""
     out = []
     for g in cands:
-        if g is f or np.dot(g.n_out, f.n_out) < 0.97 or abs(np.dot(g.center - f.center, f.n_out)) > 0.03:
+        if g is f or np.dot(g.n_out, f.n_out) < r.parallel_cos or abs(np.dot(g.center - f.center, f.n_out)) > r.coplanar_offset:
             continue
         gu = (float(g.center @ f.u) - g.w / 2, float(g.center @ f.u) + g.w / 2)
-        same_rows = abs(g.extent_v[0] - f.extent_v[0]) < 0.05 and abs(g.extent_v[1] - f.extent_v[1]) < 0.05
-        same_cols = abs(gu[0] - f.extent_u[0]) < 0.05 and abs(gu[1] - f.extent_u[1]) < 0.05
+        a = r.neighbour_align
+        same_rows = abs(g.extent_v[0] - f.extent_v[0]) < a and abs(g.extent_v[1] - f.extent_v[1]) < a
+        same_cols = abs(gu[0] - f.extent_u[0]) < a and abs(gu[1] - f.extent_u[1]) < a
         if same_rows and 0 <= gu[0] - f.extent_u[1] < r.neighbour_gap:
             out.append((g, "right"))
         elif same_rows and 0 <= f.extent_u[0] - gu[1] < r.neighbour_gap:
@@ -334,11 +337,11 @@ def _neighbours(f: Front, cands: list[Front], r: FrontRules) -> list[tuple[Front
 def _opening_sign(axis: np.ndarray, origin: np.ndarray, probe: np.ndarray, n_out: np.ndarray) -> np.ndarray:
     """Flip ``axis`` so that a small positive rotation moves ``probe`` out along ``n_out``."""
     a = Articulation(joint_type="revolute", axis=axis, origin=origin, lower=0.0, upper=1.0)
-    moved = a.move(probe[None], 0.1)[0]
+    moved = a.move(probe[None], _OPENING_PROBE)[0]
     return axis if np.dot(moved - probe, n_out) > 0 else -axis
 
 
-def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]], r: FrontRules,
+def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]], r: FrontRulesConfig,
            side_hinged: bool = False) -> tuple[str, Articulation]:
     """Kind and joint from shape and handle. ``side_hinged``: the front is known to be a door hinged at a
     side (a room door: its lever handle is horizontal, which would read as a drop door or a drawer)."""
@@ -357,7 +360,7 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
     if side_hinged:
         horizontal, stacked = False, False
     if (horizontal and f.h <= r.drawer_max_h) or (hpts is None and f.h <= r.drawer_max_h and (f.w >= f.h or stacked)):
-        return "drawer", Articulation(joint_type="prismatic", axis=f.n_out, origin=centre, lower=0.0, upper=0.3,
+        return "drawer", Articulation(joint_type="prismatic", axis=f.n_out, origin=centre, lower=0.0, upper=r.drawer_travel,
                                       limit_source="heuristic")
     if horizontal and not (hcv < cv and f.extent_v[1] < r.flap_min_top):  # no flap lifts under a worktop
         low = hcv < cv
@@ -366,7 +369,7 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
         probe = on_plane(cu, f.extent_v[0] if low else f.extent_v[1])
         axis = _opening_sign(f.u.copy(), origin, probe, f.n_out)
         return ("flap" if low else "drop"), Articulation(joint_type="revolute", axis=axis, origin=origin, lower=0.0,
-                                                        upper=float(np.radians(90)), limit_source="heuristic")
+                                                        upper=float(np.radians(r.flap_max_deg)), limit_source="heuristic")
     if hpts is not None:
         hinge_left = hcu > cu
     else:
@@ -377,11 +380,11 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
     probe = on_plane(f.extent_u[1] if hinge_left else f.extent_u[0], cv)
     axis = _opening_sign(z.copy(), origin, probe, f.n_out)
     return "door", Articulation(joint_type="revolute", axis=axis, origin=origin, lower=0.0,
-                                upper=float(np.radians(100)), limit_source="heuristic")
+                                upper=float(np.radians(r.door_max_deg)), limit_source="heuristic")
 
 
-def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None:
-    """Bottom-hinged guesses ("drop") for fronts standing side by side with a door-tall (>= 0.5 m) front
+def doors_in_rows(fronts: list[Front], rules: FrontRulesConfig = FrontRulesConfig()) -> None:
+    """Bottom-hinged guesses ("drop") for fronts standing side by side with a door-tall (``row_door_min_h``) front
     that also carries a horizontal bar handle are cabinet doors with bar handles, not ovens: appliances
     come one at a time. (Rows of flaps exist: wall cabinets are often all top-hinged. Bar heights are
     not compared: a scan's bar detections stray by 10-60 cm, RedKitchen L2/L3.)
@@ -399,7 +402,7 @@ def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None
             continue
         for g in fronts:
             hg = bar_height(g)
-            if g is f or hg is None or g.h < 0.5 or not _side_by_side(f, g, rules):  # a drawer beside an oven: no row
+            if g is f or hg is None or g.h < rules.row_door_min_h or not _side_by_side(f, g, rules):  # a drawer beside an oven: no row
                 continue
             retype.append(f)
             break
@@ -408,12 +411,12 @@ def doors_in_rows(fronts: list[Front], rules: FrontRules = FrontRules()) -> None
         f.kind = "door"
 
 
-def _side_by_side(f: Front, g: Front, r: FrontRules) -> bool:
-    """Coplanar fronts touching left/right (gap < ``neighbour_gap``) whose heights overlap by >= 70 %
-    of the smaller one (image cells of one run differ by a few cm at top and bottom)."""
-    if np.dot(g.n_out, f.n_out) < 0.97 or abs(np.dot(g.center - f.center, f.n_out)) > 0.03:
+def _side_by_side(f: Front, g: Front, r: FrontRulesConfig) -> bool:
+    """Coplanar fronts touching left/right (gap < ``neighbour_gap``, overlap <= ``row_overlap``) whose heights
+    overlap by ``row_min_height_share`` of the smaller one (image cells of one run differ by a few cm at top and bottom)."""
+    if np.dot(g.n_out, f.n_out) < r.parallel_cos or abs(np.dot(g.center - f.center, f.n_out)) > r.coplanar_offset:
         return False
     gu = (float(g.center @ f.u) - g.w / 2, float(g.center @ f.u) + g.w / 2)
     gap = max(gu[0] - f.extent_u[1], f.extent_u[0] - gu[1])
     ov = min(g.extent_v[1], f.extent_v[1]) - max(g.extent_v[0], f.extent_v[0])
-    return -0.01 <= gap < r.neighbour_gap and ov >= 0.7 * min(f.h, g.h)
+    return -r.row_overlap <= gap < r.neighbour_gap and ov >= r.row_min_height_share * min(f.h, g.h)

@@ -17,78 +17,18 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import FloorConfig, HandleConfig, HeuristicConfig, ImageConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
-from .front_cells import Cell, CellParams, Handle, find_handles, off_background, off_threshold, split_cells
-from .fronts import Front, FrontRules, _joint, _neighbours, doors_in_rows
-from .orthophoto import ColourCalibration, Orthophoto, OrthoParams, build_orthophotos
-from .view_registration import RegistrationParams
+from .front_cells import Cell, Handle, find_handles, off_background, off_threshold, split_cells
+from .fronts import Front, _joint, _neighbours, doors_in_rows
+from .line_evidence import LineSupport, line_support
+from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
+from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
 from .planes import Plane, vertical_planes
 
-
-_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic)
-
-
-@dataclass(frozen=True)
-class ImageFrontParams:
-    """The image path's parameters, built from ``HeuristicConfig`` by ``params_from_config``."""
-
-    ortho: OrthoParams = OrthoParams()
-    cells: CellParams = CellParams()
-    plane_offset_tol: float = _H.plane_offset_tol        # m: faces this close to a plane belong to it
-    plane_angle_tol_deg: float = _H.plane_angle_tol_deg
-    plane_refit_deg: float = _H.plane_refit_deg          # deg: direction search from face positions (0: off)
-    plane_refit_min_gain: float = _H.plane_refit_min_gain  # ... taken only when this much sharper
-    min_plane_area: float = _H.min_plane_area            # m²
-    plane_cell: float = _H.plane_cell                    # m: pieces of one plane farther apart are separate planes
-    plane_min_fragment_area: float = _H.plane_min_fragment_area  # m²: smaller coverage fragments are not the plane's
-    face_depth: tuple[float, float] = _H.face_depth      # m behind / in front of the plane taken into a front
-    outline_fill_px: int = _H.outline_fill_px            # holes/notches this wide are inside the plane's outline
-    protrusion_depth: tuple[float, float] = _H.protrusion_depth  # m in front of the plane: mesh handles
-    min_tile_side: float = _H.min_tile_side              # m: handle-less cells smaller than this both ways are tiles, not fronts
-    handleless_min_seams: int = _H.handleless_min_seams  # a handle-less cell cut out by this many straight seams is a front (0: never)
-    plain_floor_gap: float = _H.plain_floor_gap          # m: a handle-less front reaching this close to the floor is wall (0: off)
-    floor_min_area: float = _H.floor_min_area            # m²: upward-facing area that makes a 2 cm band the floor
-    cell_median_clutter: bool = _H.clutter_cell_median  # clutter also judged against the cell's own median colour
-    line_min_len: float = _H.clutter_line_min_len        # m: straight lines this long (and thin) are a front's structure, not clutter
-    line_max_width: float = _H.clutter_line_max_width    # m
-    handle_shadows: bool = _H.handle_shadows            # enclosed unseen handle-shaped holes are handles
-    protrusion_from_surface: bool = _H.protrusion_from_surface  # mesh handles stand out from the surface around, not the plane
-
-
-def params_from_config(cfg: HeuristicConfig) -> ImageFrontParams:
-    """The image path's parameters from the pipeline config (every threshold lives there; the one
-    place they are built)."""
-    return ImageFrontParams(
-        ortho=OrthoParams(resolution=cfg.ortho_resolution, max_side_px=cfg.ortho_max_side_px, max_views=cfg.max_views,
-                          min_cos=cfg.ortho_min_cos, render_scale=cfg.ortho_render_scale, erode_px=cfg.ortho_erode_px,
-                          edge_jump=cfg.ortho_edge_jump, depth_tol=cfg.ortho_depth_tol, margin=cfg.ortho_margin,
-                          calibrate=cfg.calibrate_colour, scale_range=tuple(cfg.calib_scale_range),
-                          shift_range_px=cfg.calib_shift_range_px, min_gain=cfg.calib_min_gain,
-                          register=RegistrationParams(sigmas_px=tuple(cfg.register_sigmas_px),
-                                                      prior_scale=cfg.register_prior_scale,
-                                                      prior_shift_px=cfg.register_prior_shift_px)),
-        cells=CellParams(seam_contrast=cfg.seam_contrast, seam_span=cfg.seam_span, seam_prominence=cfg.seam_prominence,
-                         seam_prominence_h=cfg.seam_prominence_h, min_front=cfg.min_front_side,
-                         handle_contrast=cfg.handle_contrast, handle_len=tuple(cfg.handle_len),
-                         handle_thick=tuple(cfg.handle_thick), handle_aspect=cfg.handle_aspect,
-                         background_win=cfg.handle_background_win, min_seen=cfg.cell_min_seen,
-                         max_clutter=cfg.max_clutter, max_clutter_handle=cfg.max_clutter_handle, outline_margin=cfg.handle_outline_margin,
-                         side_cover=cfg.handle_side_cover,
-                         texture_factor=cfg.texture_factor, seam_z=cfg.seam_z, step_contrast=cfg.step_contrast,
-                         step_z=cfg.step_z, max_depth=cfg.max_split_depth, step_over_dip=cfg.step_over_dip,
-                         outline_step=cfg.outline_step),
-        plane_offset_tol=cfg.plane_offset_tol, plane_angle_tol_deg=cfg.plane_angle_tol_deg, plane_refit_deg=cfg.plane_refit_deg,
-        plane_refit_min_gain=cfg.plane_refit_min_gain,
-        min_plane_area=cfg.min_plane_area, plane_cell=cfg.plane_cell, plane_min_fragment_area=cfg.plane_min_fragment_area,
-        face_depth=tuple(cfg.face_depth), outline_fill_px=cfg.outline_fill_px,
-        protrusion_depth=tuple(cfg.protrusion_depth), min_tile_side=cfg.min_tile_side,
-        handleless_min_seams=cfg.handleless_min_seams, plain_floor_gap=cfg.plain_floor_gap,
-        floor_min_area=cfg.floor_min_area, cell_median_clutter=cfg.clutter_cell_median,
-        line_min_len=cfg.clutter_line_min_len, line_max_width=cfg.clutter_line_max_width, handle_shadows=cfg.handle_shadows,
-        protrusion_from_surface=cfg.protrusion_from_surface)
+_MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
 
 
 @dataclass
@@ -102,17 +42,19 @@ class ImageFronts:
     orthophotos: list[Orthophoto]
     calibration: ColourCalibration
     registration: dict[int, ColourCalibration] = field(default_factory=dict)  # per-view correction by frame index
+    lines: list[LineSupport] = field(default_factory=list)  # learned line support per plane (empty: not used)
 
 
-def floor_height(mesh: TriMesh, min_area: float, band: float = 0.02, min_up: float = 0.9) -> float | None:
+def floor_height(mesh: TriMesh, cfg: FloorConfig) -> float | None:
     """Height of the floor: the area-weighted median height of the lowest ``band``-high slice of
-    upward-facing faces holding ``min_area`` m²; None when no slice does (a scan without its floor)."""
-    up = mesh.face_normals[:, 2] > min_up
-    if not up.any() or min_area <= 0:
+    faces facing up (normal z above ``min_up``) holding ``min_area`` m²; None when no slice does (a
+    scan without its floor)."""
+    up = mesh.face_normals[:, 2] > cfg.min_up
+    if not up.any() or cfg.min_area <= 0:
         return None
     z, a = mesh.face_centroids[up, 2], mesh.face_areas[up]
-    bins = np.floor((z - z.min()) / band).astype(int)
-    full = np.flatnonzero(np.bincount(bins, weights=a) >= min_area)
+    bins = np.floor((z - z.min()) / cfg.band).astype(int)
+    full = np.flatnonzero(np.bincount(bins, weights=a) >= cfg.min_area)
     if not len(full):
         return None
     zb, ab = z[bins == full[0]], a[bins == full[0]]
@@ -121,9 +63,9 @@ def floor_height(mesh: TriMesh, min_area: float, band: float = 0.02, min_up: flo
     return float(zb[order][np.searchsorted(cum, 0.5 * cum[-1])])  # area-weighted median of the band
 
 
-def floor_level(mesh: TriMesh, min_area: float) -> float:
+def floor_level(mesh: TriMesh, cfg: FloorConfig) -> float:
     """:func:`floor_height`, else the mesh's lowest point (rules that need a floor always get one)."""
-    floor = floor_height(mesh, min_area)
+    floor = floor_height(mesh, cfg)
     return float(mesh.vertices[:, 2].min()) if floor is None else floor
 
 
@@ -134,8 +76,9 @@ def off_the_floor(fronts: list[Front], floor: float | None, gap: float) -> list[
     return [f for f in fronts if f.handle_points is not None or f.extent_v[0] > floor + gap]
 
 
-def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = _H.plane_min_fragment_area) -> np.ndarray:
-    """Grid pixels covered by the plane's own faces (centroids splatted, small holes closed)."""
+def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) -> np.ndarray:
+    """Grid pixels covered by the plane's own faces (centroids splatted, holes up to ``close`` m closed,
+    fragments under ``min_area`` m² dropped)."""
     h, w = o.n_views.shape
     cen = mesh.face_centroids[o.plane.faces]
     c = np.floor((cen @ o.plane.u - o.u0) / o.res).astype(int)
@@ -143,17 +86,17 @@ def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float = _H.plane_min_fr
     ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
     cov = np.zeros((h, w), np.uint8)
     cov[r[ok], c[ok]] = 1
-    k = max(3, int(round(0.02 / o.res)) | 1)
+    k = max(MIN_KERNEL, int(round(close / o.res)) | 1)
     cov = cv2.morphologyEx(cov, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
     cov = cov.astype(np.uint8)
     # stray fragments (bits of floor or wall that happen to lie in the plane) are not part of it
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(cov, connectivity=8)
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(cov, connectivity=CONNECTIVITY)
     keep = np.zeros(n, bool)
     keep[1:] = stats[1:, cv2.CC_STAT_AREA] * o.res ** 2 >= min_area
     return keep[lab]
 
 
-def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick: float = 0.03,
+def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick: float,
                    row_limit: int | None = None) -> np.ndarray:
     """Horizontal unseen holes inside the outline, at least ``min_thick`` tall, that do not reach the
     outline's border (and, with ``row_limit``, lie wholly above that orthophoto row).
@@ -164,10 +107,10 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
     holes are left out: those are the unseen gaps between fronts. Below eye level the views look down
     on a bar and see its colour; holes there are left to the colour test."""
     hole = (outline & ~seen).astype(np.uint8)
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(hole, connectivity=8)
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(hole, connectivity=CONNECTIVITY)
     if n <= 1:
         return np.zeros(seen.shape, bool)
-    border = cv2.dilate((~outline).astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
+    border = cv2.dilate((~outline).astype(np.uint8), NEIGHBOURS).astype(bool)
     border[[0, -1], :] = True
     border[:, [0, -1]] = True
     w, h = stats[:, cv2.CC_STAT_WIDTH], stats[:, cv2.CC_STAT_HEIGHT]
@@ -179,7 +122,7 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
     return keep[lab]
 
 
-def cov_outline(cov: np.ndarray, px: int = _H.outline_fill_px) -> np.ndarray:
+def cov_outline(cov: np.ndarray, px: int) -> np.ndarray:
     """The plane's outline with holes and notches up to ``px`` wide filled: a pixel is inside when
     the plane is within ``px`` on both sides of it along a row or along a column (a handle's scanning
     shadow is a hole, or a notch where the handle sits at the front's edge; a closing misses both once
@@ -200,7 +143,7 @@ def thin_lines(mask: np.ndarray, res: float, min_len: float, max_width: float) -
     if min_len <= 0 or not mask.any():
         return np.zeros(mask.shape, bool)
     m = mask.astype(np.uint8)
-    L = max(3, int(round(min_len / res)))
+    L = max(MIN_KERNEL, int(round(min_len / res)))
     t = max(2, int(round(max_width / res)) + 1)
     long_h = cv2.morphologyEx(m, cv2.MORPH_OPEN, np.ones((1, L), np.uint8))
     long_v = cv2.morphologyEx(m, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
@@ -209,33 +152,34 @@ def thin_lines(mask: np.ndarray, res: float, min_len: float, max_width: float) -
     return ((long_h & ~thick_v) | (long_v & ~thick_h)).astype(bool)
 
 
-def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray,
-                   depth: tuple[float, float] = _H.protrusion_depth, win: float = 0.0,
-                   behind: float = _H.plane_offset_tol) -> np.ndarray:
-    """Grid pixels under outward-facing faces standing ``depth`` in front of the plane (handles in the
-    mesh), splatted by centroid, closed over 2 px and grown by 1 px: the centroids of a bar's faces sit
-    half a face inside its outline, and a 1.5 cm bar at 4 mm must not come out 2 px wide.
+def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray, hc: HandleConfig, win: float,
+                   behind: float) -> np.ndarray:
+    """Grid pixels under outward-facing faces standing ``hc.protrusion_depth`` in front of the plane
+    (handles in the mesh), splatted by centroid, closed over ``hc.bar_close_px`` and grown by 1 px: the
+    centroids of a bar's faces sit half a face inside its outline, and a 1.5 cm bar at 4 mm must not
+    come out 2 px wide.
 
     With ``win`` > 0 (``protrusion_from_surface``, the default since version 14) they stand ``depth`` in front of the surface
-    around them instead: the median offset of the faces within ``win`` (2 cm blocks, each its faces'
-    median). A TSDF wall lies a centimetre or two off its fitted plane in places, and its bumps there
-    are no handles."""
+    around them instead: the median offset of the faces within ``win`` (``hc.surface_block`` blocks, each its
+    faces' median), faces from ``behind`` the plane on. A TSDF wall lies a centimetre or two off its fitted
+    plane in places, and its bumps there are no handles."""
     h, w = o.n_views.shape
     p = o.plane
+    depth, block = hc.protrusion_depth, hc.surface_block
     dn = centroids @ p.n - p.d
     # outward faces that can stand out: against the plane, from depth[0]; against the surface, from behind it
-    cand = np.flatnonzero((dn > (-behind if win > 0 else depth[0])) & (dn < depth[1]) & (normals @ p.n > 0.5))
+    cand = np.flatnonzero((dn > (-behind if win > 0 else depth[0])) & (dn < depth[1]) & (normals @ p.n > hc.protrusion_min_cos))
     c = np.floor((centroids[cand] @ p.u - o.u0) / o.res).astype(int)
     r = np.floor((o.v_top - centroids[cand, 2]) / o.res).astype(int)
     ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
     dn, r, c = dn[cand][ok], r[ok], c[ok]
     if win > 0:
-        dn = dn - _local_surface(dn, r, c, (h, w), max(1, int(round(0.02 / o.res))), win / 0.02)[r, c]
+        dn = dn - _local_surface(dn, r, c, (h, w), max(1, int(round(block / o.res))), win / block)[r, c]
     sel = (dn > depth[0]) & (dn < depth[1])
     out = np.zeros((h, w), np.uint8)
     out[r[sel], c[sel]] = 1
-    out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((5, 5), np.uint8))
-    return cv2.dilate(out, np.ones((3, 3), np.uint8)).astype(bool)
+    out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((hc.bar_close_px, hc.bar_close_px), np.uint8))
+    return cv2.dilate(out, NEIGHBOURS).astype(bool)
 
 
 def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[int, int], block: int,
@@ -255,69 +199,75 @@ def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[in
     has = cnt > 0
     coarse[has] = dn[order][start[has] + cnt[has] // 2]
     coarse = coarse.reshape(bh, bw)
-    k = max(3, int(round(win_blocks)) | 1)
+    k = max(MIN_KERNEL, int(round(win_blocks)) | 1)
     padded = np.pad(coarse, k // 2, constant_values=np.nan)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # windows without faces stay NaN -> 0
         win = np.lib.stride_tricks.sliding_window_view(padded, (k, k))
         local = np.nanmedian(win, axis=(-2, -1))
     inside = np.lib.stride_tricks.sliding_window_view(np.pad(np.ones(coarse.shape), k // 2), (k, k)).sum((-2, -1))
-    local[np.isfinite(win).sum((-2, -1)) * 3 < inside] = 0.0
+    local[np.isfinite(win).sum((-2, -1)) * _MIN_SURFACE_DIV < inside] = 0.0
     local = np.nan_to_num(local, nan=0.0)
     return np.repeat(np.repeat(local, block, 0), block, 1)[:h, :w]
 
 
 def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, read_rgb: Callable[[Frame], np.ndarray],
-                      rules: FrontRules = FrontRules(), params: ImageFrontParams = ImageFrontParams(),
-                      taken_faces: np.ndarray | None = None, mesh_fronts: Sequence[Front] = ()) -> ImageFronts:
-    """Fronts from the colour frames (see module docstring). ``taken_faces`` (bool per face) are
-    faces of fronts already found on the mesh: cells overlapping them are left to the mesh rules."""
-    cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, 3))
-    planes = vertical_planes(mesh, cams.mean(0), max_tilt=rules.max_tilt, angle_tol_deg=params.plane_angle_tol_deg,
-                             offset_tol=params.plane_offset_tol, min_area=max(params.min_plane_area, rules.min_w * rules.min_h),
-                             cell=params.plane_cell, refit_deg=params.plane_refit_deg,
-                             refit_min_gain=params.plane_refit_min_gain)
-    orthos, calib, per_view = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, params.ortho)
+                      cfg: HeuristicConfig = HeuristicConfig(), taken_faces: np.ndarray | None = None,
+                      mesh_fronts: Sequence[Front] = (),
+                      detect_lines: Callable[[np.ndarray], np.ndarray] | None = None) -> ImageFronts:
+    """Fronts from the colour frames (see module docstring), by the rules of ``cfg``. ``taken_faces``
+    (bool per face) are faces of fronts already found on the mesh: cells overlapping them are left to
+    the mesh rules. ``detect_lines`` (an RGB image -> its line segments (N, 4+: x0, y0, x1, y1 px)) gives
+    learned seam evidence when ``lines.enabled`` (line_evidence.py)."""
+    rules, hc, clut = cfg.fronts, cfg.handles, cfg.clutter
+    cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, XYZ))
+    planes = vertical_planes(mesh, cams.mean(0), cfg.planes, max_tilt=rules.max_tilt,
+                             min_area=max(cfg.planes.min_area, rules.min_w * rules.min_h))
+    orthos, calib, per_view = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, cfg.ortho,
+                                                cfg.calibration, cfg.registration)
+    supports: list[LineSupport] = []
+    if cfg.lines.enabled and detect_lines is not None:
+        supports = line_support(orthos, frames, raster, read_rgb, detect_lines, lambda fi: per_view.get(fi, calib), cfg)
     centroids, normals = mesh.face_centroids, mesh.face_normals
     fronts: list[Front] = []
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     diffs = []
-    for o in orthos:
-        cov = coverage_map(o, mesh, params.plane_min_fragment_area)
+    for i, o in enumerate(orthos):
+        cov = coverage_map(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         o.n_views[~cov] = 0  # where the plane's own faces are not (floor, worktop edge seen at the same depth)
-        diff = off_background(o, params.cells)
+        diff = off_background(o, hc)
         diffs.append(diff)
-        outline = cov_outline(cov, params.outline_fill_px)  # handle shadows are holes in the plane, not its outline
-        win = params.cells.background_win if params.protrusion_from_surface else 0.0
-        bars = protrusion_map(o, centroids, normals, params.protrusion_depth, win, params.plane_offset_tol)
-        handles = find_handles(o, cov, params.cells, diff, bars & outline, outline)
+        outline = cov_outline(cov, cfg.image.outline_fill_px)  # handle shadows are holes in the plane, not its outline
+        win = hc.background_win if hc.protrusion_from_surface else 0.0
+        bars = protrusion_map(o, centroids, normals, hc, win, cfg.planes.offset_tol)
+        handles = find_handles(o, cov, cfg, diff, bars & outline, outline)
         shadows: list[Handle] = []
-        if params.handle_shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
+        if hc.shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
             eye_row = int(np.floor((o.v_top - float(np.median(cams[:, 2]))) / o.res))  # cameras' median height
-            holes = enclosed_holes(o.n_views > 0, outline, o.res, row_limit=eye_row)
-            shadows = find_handles(o, cov, params.cells, np.zeros_like(diff), holes, outline) if holes.any() else []
-        thr = off_threshold(diff, o.n_views > 0, params.cells)
+            holes = enclosed_holes(o.n_views > 0, outline, o.res, hc.shadow_min_thick, row_limit=eye_row)
+            shadows = find_handles(o, cov, cfg, np.zeros_like(diff), holes, outline) if holes.any() else []
+        thr = off_threshold(diff, o.n_views > 0, cfg)
         clutter = (diff > thr) & (o.n_views > 0)
-        structure = thin_lines(clutter, o.res, params.line_min_len, params.line_max_width)
+        structure = thin_lines(clutter, o.res, clut.line_min_len, clut.line_max_width)
         for h in handles:  # a handle is not clutter
             structure[h.pixels[:, 1], h.pixels[:, 0]] = True
         clutter &= ~structure
         p = o.plane
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
-        cells = split_cells(o, cov, handles, params.cells)
-        tiled = any(max(c.c1 - c.c0, c.r1 - c.r0) * o.res < params.min_tile_side
-                    and cov[c.r0:c.r1, c.c0:c.c1].mean() >= params.cells.min_seen for c in cells)
+        cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None)
+        tiled = any(max(c.c1 - c.c0, c.r1 - c.r0) * o.res < cfg.cells.min_tile_side
+                    and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cfg.cells.min_seen for c in cells)
         for cell in cells:
-            f = _cell_front(o, cell, cov, clutter, in_plane, rules, params, None,
-                            (thr, structure) if params.cell_median_clutter else None)
+            f = _cell_front(o, cell, cov, clutter, in_plane, cfg, None,
+                            (thr, structure) if clut.cell_median else None)
             if f is not None:
                 if f.handle_points is None:
                     f.shadow_points = _shadow_in_cell(o, cell, shadows)
                 fronts.append(f)
-                if not tiled and 0 < params.handleless_min_seams <= cell.seam_cuts:
+                if not tiled and 0 < cfg.cells.handleless_min_seams <= cell.seam_cuts:
                     gridded.add(id(f))
-    fronts, split_mesh = _settle_with_mesh_fronts(fronts, taken_faces, mesh_fronts, mesh.n_faces)
+    fronts, split_mesh = _settle_with_mesh_fronts(fronts, taken_faces, mesh_fronts, mesh.n_faces, cfg.image)
     # a handle-less cell is a front beside a front with a handle, or when straight seams along its whole
     # length cut it out on ``handleless_min_seams`` sides (push-to-open fronts); tiles and splash-backs
     # have no handles and, tiled, cells smaller than a front
@@ -325,14 +275,14 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
               or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
     # ... but a handle-less panel that reaches down to the floor is wall (beside a room door, say): base
     # units stand on a plinth and room doors have handles
-    if params.plain_floor_gap > 0:
-        fronts = off_the_floor(fronts, floor_height(mesh, params.floor_min_area), params.plain_floor_gap)
+    if cfg.image.plain_floor_gap > 0:
+        fronts = off_the_floor(fronts, floor_height(mesh, cfg.floor), cfg.image.plain_floor_gap)
     for f in fronts:
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else f.shadow_points
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
-    vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, params)})
-    return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view)
+    vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, cfg)})
+    return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
 
 
 def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.ndarray | None:
@@ -345,12 +295,12 @@ def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.
 
 
 def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh_fronts: Sequence[Front],
-                             n_faces: int) -> tuple[list[Front], set[int]]:
+                             n_faces: int, p: ImageConfig) -> tuple[list[Front], set[int]]:
     """Image fronts beside the fronts found on the mesh. A mesh front holding two or more image fronts
     with handles is several fronts the mesh could not tell apart (a TSDF dresser is one facet): it is
-    replaced by them. Otherwise the mesh front stands: an image front lying mostly (> 30 %) on its faces
-    is dropped, and one touching it loses those faces. Returns the kept image fronts and the indices of
-    the mesh fronts replaced."""
+    replaced by them. Otherwise the mesh front stands: an image front lying mostly (> ``mesh_share``) on
+    its faces is dropped, and one touching it loses those faces (it keeps ``min_faces`` or goes). Returns
+    the kept image fronts and the indices of the mesh fronts replaced."""
     if taken is None or not taken.any():
         return fronts, set()
     owner = np.full(n_faces, -1, np.int64)
@@ -370,41 +320,42 @@ def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh
     kept = []
     for f in fronts:
         on = standing[f.faces]
-        if on.sum() > 0.3 * max(len(f.faces), 1):
+        if on.sum() > p.mesh_share * max(len(f.faces), 1):
             continue
         f.faces = f.faces[~on]
-        if len(f.faces) >= 4:
+        if len(f.faces) >= p.min_faces:
             kept.append(f)
     return kept, split
 
 
-def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarray], params: ImageFrontParams) -> bool:
+def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarray], cfg: HeuristicConfig) -> bool:
     """A mesh front whose picture is cluttered (a tiled wall with a socket "handle") is not a front:
-    its rectangle in the orthophoto of its plane has more than ``max_clutter`` off-background pixels
-    (``diffs``: each orthophoto's off-background map, computed once)."""
+    its rectangle in the orthophoto of its plane has more than ``clutter.max_share`` off-background pixels
+    (``diffs``: each orthophoto's off-background map, computed once; ``image.veto_*``: which plane, how much seen)."""
+    im = cfg.image
     for o, diff_o in zip(orthos, diffs):
         p = o.plane
-        if np.dot(p.n, f.n_out) < 0.97 or abs(float(f.center @ p.n) - p.d) > 0.08:
+        if np.dot(p.n, f.n_out) < cfg.fronts.parallel_cos or abs(float(f.center @ p.n) - p.d) > im.veto_plane_offset:
             continue
         h, w = o.n_views.shape
         c0, c1 = int((f.extent_u[0] - o.u0) / o.res), int(np.ceil((f.extent_u[1] - o.u0) / o.res))
         r0, r1 = int((o.v_top - f.extent_v[1]) / o.res), int(np.ceil((o.v_top - f.extent_v[0]) / o.res))
         c0, c1, r0, r1 = max(c0, 0), min(c1, w), max(r0, 0), min(r1, h)
-        if c1 - c0 < 5 or r1 - r0 < 5:
+        if c1 - c0 < im.veto_min_px or r1 - r0 < im.veto_min_px:
             continue
         seen = o.n_views[r0:r1, c0:c1] > 0
-        if seen.sum() < 0.3 * seen.size:
+        if seen.sum() < im.veto_min_seen * seen.size:
             continue
         diff = diff_o[r0:r1, c0:c1]
-        return bool((diff[seen] > params.cells.handle_contrast).mean() > params.cells.max_clutter)
+        return bool((diff[seen] > cfg.handles.contrast).mean() > cfg.clutter.max_share)
     return False
 
 
 def _clutter_share(o: Orthophoto, cell: Cell, clutter: np.ndarray, seen: np.ndarray,
-                   plain: tuple[float, np.ndarray] | None) -> float:
+                   plain: tuple[float, np.ndarray] | None, min_px: int) -> float:
     """Share of a cell's seen pixels that are clutter: off their local background (``clutter``), unless
     they are close to the cell's own median colour (``plain`` = (threshold, structure pixels to leave
-    out)). The local background is a 12 cm median, which on a front beside a front of another colour
+    out); judged so on ``min_px`` such pixels at least). The local background is a 12 cm median, which on a front beside a front of another colour
     (or a dark gap) takes the neighbour's colour in a band along every edge; the cell's own median
     does not, while a poster or a shelf still differs from the wall around it."""
     sl = (slice(cell.r0, cell.r1), slice(cell.c0, cell.c1))
@@ -413,7 +364,7 @@ def _clutter_share(o: Orthophoto, cell: Cell, clutter: np.ndarray, seen: np.ndar
         return share
     thr, structure = plain
     keep = seen & ~structure[sl]
-    if keep.sum() < 50:
+    if keep.sum() < min_px:
         return share
     col = o.color[sl]
     med = np.median(col[keep], axis=0)
@@ -421,16 +372,17 @@ def _clutter_share(o: Orthophoto, cell: Cell, clutter: np.ndarray, seen: np.ndar
     return min(share, float(off[keep].mean()))
 
 
-def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, in_plane: np.ndarray, rules: FrontRules,
-                params: ImageFrontParams, taken: np.ndarray | None,
+def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, in_plane: np.ndarray,
+                cfg: HeuristicConfig, taken: np.ndarray | None,
                 plain: tuple[float, np.ndarray] | None = None) -> Front | None:
     """The front of one cell, or None when the cell is not door/drawer-like."""
+    rules, clut = cfg.fronts, cfg.clutter
     sub = cov[cell.r0:cell.r1, cell.c0:cell.c1]
-    if sub.size == 0 or sub.mean() < params.cells.min_seen:
+    if sub.size == 0 or sub.mean() < cfg.cells.min_seen:
         return None
     seen = o.n_views[cell.r0:cell.r1, cell.c0:cell.c1] > 0
-    limit = max(params.cells.max_clutter, params.cells.max_clutter_handle) if cell.handles else params.cells.max_clutter
-    if seen.any() and _clutter_share(o, cell, clutter, seen, plain) > limit:
+    limit = max(clut.max_share, clut.max_share_handle) if cell.handles else clut.max_share
+    if seen.any() and _clutter_share(o, cell, clutter, seen, plain, clut.median_min_px) > limit:
         return None  # posters, tiles, shelves: a front is a plain panel
     rows, cols = np.nonzero(sub)
     c0, c1 = cell.c0 + cols.min(), cell.c0 + cols.max() + 1   # tighten to the covered area
@@ -440,18 +392,18 @@ def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray,
     w, h = u_b - u_a, v_b - v_a
     if not (rules.min_w <= w <= rules.max_w and rules.min_h <= h <= rules.max_h):
         return None
-    if not cell.handles and (cell.cut_sides < 2 or max(w, h) < params.min_tile_side):
+    if not cell.handles and (cell.cut_sides < 2 or max(w, h) < cfg.cells.min_tile_side):
         return None  # a plain panel or a tile: not openable by these rules
     p = o.plane
     du, dv, dn = in_plane[:, 0], in_plane[:, 1], in_plane[:, 2]
     inside = ((du > u_a) & (du < u_b) & (dv > v_a) & (dv < v_b)
-              & (dn > params.face_depth[0]) & (dn < params.face_depth[1]))
+              & (dn > cfg.image.face_depth[0]) & (dn < cfg.image.face_depth[1]))
     if taken is not None:
-        if taken[inside].sum() > 0.3 * max(inside.sum(), 1):
+        if taken[inside].sum() > cfg.image.mesh_share * max(inside.sum(), 1):
             return None
         inside &= ~taken
     faces = np.flatnonzero(inside)
-    if len(faces) < 4:
+    if len(faces) < cfg.image.min_faces:
         return None
     center = p.to_world(0.5 * (u_a + u_b), 0.5 * (v_a + v_b))
     hp = [p.to_world(*o.to_uv(hd.pixels[:, 0], hd.pixels[:, 1])) for hd in cell.handles]

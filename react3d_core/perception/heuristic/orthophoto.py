@@ -23,35 +23,19 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import CalibrationConfig, OrthoConfig, RegistrationConfig
 from ...data.frames import Frame
 from ...raster import Rasterizer
 from .colour_sampling import ColourCalibration, Points as _Points, nanmedian as _nanmedian, \
     pixel_coords as _pixel_coords, remap_points as _remap_points
+from .constants import NEIGHBOURS, RGB
 from .planes import Plane
-from .view_registration import RegistrationParams, register_views
+from .view_registration import register_views
 
-_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic.ortho_*, calib_*)
-
-
-@dataclass(frozen=True)
-class OrthoParams:
-    """Orthophoto parameters, built from ``HeuristicConfig`` by ``image_fronts.params_from_config``."""
-
-    resolution: float = _H.ortho_resolution      # m per grid pixel
-    max_side_px: int = _H.ortho_max_side_px      # coarser grid for very large planes
-    max_views: int = _H.max_views                # views per plane, best first
-    min_cos: float = _H.ortho_min_cos            # views more grazing than this are not used
-    render_scale: float = _H.ortho_render_scale  # face-id buffer size relative to the colour image
-    erode_px: int = _H.ortho_erode_px            # depth-buffer pixels kept away from depth jumps (occluder outlines)
-    edge_jump: float = _H.ortho_edge_jump        # m: a depth jump between neighbouring pixels that marks an outline
-    depth_tol: float = _H.ortho_depth_tol        # m (+1 % of the distance): a plane point is seen when the scan is there
-    margin: float = _H.ortho_margin              # m of grid around a plane's extent
-    calibrate: bool = _H.calibrate_colour        # self-calibrate colour focal scale / principal-point shift
-    scale_range: tuple[float, float] = _H.calib_scale_range
-    shift_range_px: float = _H.calib_shift_range_px  # at 640 px image width
-    min_gain: float = _H.calib_min_gain          # a calibration must cut the disagreement by this fraction to be used
-    register: RegistrationParams = RegistrationParams()  # per-view correction on top of the scene calibration
+_NEAR = 0.1  # m: points closer to the camera than this are at or behind it (no projection)
+_WINDOW_STEP = 4  # grid points: a plane's window in a view is found on every this-many-th point, widened by one
+_MIN_SAMPLES = 20  # a view with fewer samples of a plane tells nothing about its exposure there
+_PICK_GRID = 5  # views are scored on this many x this many points of a plane
 
 
 @dataclass
@@ -120,10 +104,13 @@ def _grid(plane: Plane, res: float, margin: float) -> tuple[np.ndarray, float, f
 
 
 def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: Rasterizer, n_faces: int,
-                      read_rgb: Callable[[Frame], np.ndarray], params: OrthoParams = OrthoParams()
+                      read_rgb: Callable[[Frame], np.ndarray], params: OrthoConfig = OrthoConfig(),
+                      calibration: CalibrationConfig = CalibrationConfig(),
+                      registration: RegistrationConfig = RegistrationConfig()
                       ) -> tuple[list[Orthophoto], ColourCalibration, dict[int, ColourCalibration]]:
-    """Fused orthophoto of each plane, the scene's colour calibration and each registered view's own
-    correction by frame index (see module docstring)."""
+    """Fused orthophoto of each plane, the scene's colour calibration (``calibration``, when enabled) and
+    each registered view's own correction by frame index (``registration``, when it has sigmas; see
+    module docstring)."""
     if not planes or not frames:
         return [], ColourCalibration(), {}
     grids = []
@@ -132,7 +119,7 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         res = max(params.resolution, span / params.max_side_px)
         grids.append((*_grid(p, res, params.margin), res))
     picks = _pick_views(planes, frames, [g[0] for g in grids], params.min_cos, params.max_views)
-    register = params.calibrate and bool(params.register.sigmas_px)
+    register = calibration.enabled and bool(registration.sigmas_px)
     views: list[list[_View]] = [[] for _ in planes]
     images: dict[int, np.ndarray] = {}
     for fi, f in enumerate(frames):
@@ -157,14 +144,14 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             rx = np.clip(np.round((np.where(inside, x, 0) + 0.5) * params.render_scale - 0.5), 0, rw - 1).astype(np.int32)
             ry = np.clip(np.round((np.where(inside, y, 0) + 0.5) * params.render_scale - 0.5), 0, rh - 1).astype(np.int32)
             # the view sees the plane point when the scan surface there is at the plane's depth
-            ok = inside & usable[ry, rx] & (np.abs(depth[ry, rx] - z) < params.depth_tol + 0.01 * np.abs(z))
-            if ok.sum() >= 50:
+            ok = inside & usable[ry, rx] & (np.abs(depth[ry, rx] - z) < params.depth_tol + params.depth_tol_rel * np.abs(z))
+            if ok.sum() >= params.min_view_px:
                 views[i].append(_View.cropped(fi, xn, ok, r0, c0, None if edge_dist is None else edge_dist[ry, rx]))
         if any(v and v[-1].frame == fi for v in views):
             images[fi] = read_rgb(f)
-    calib = _calibrate(views, frames, images, params) if params.calibrate else ColourCalibration()
+    calib = _calibrate(views, frames, images, calibration) if calibration.enabled else ColourCalibration()
     per_view = register_views(*_half_grid_points(views, [g[0].shape[:2] for g in grids]), frames, images, calib,
-                              params.register) if register else {}
+                              registration) if register else {}
     out = []
     for i, p in enumerate(planes):
         pts, u0, v_top, res = grids[i]
@@ -176,7 +163,7 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
             color = _nanmedian(st)
             spread = _nanmedian(np.abs(st.mean(-1) - color.mean(-1)[None]))
         else:
-            n, color = np.zeros(pts.shape[:2], np.int32), np.zeros(pts.shape[:2] + (3,), np.float32)
+            n, color = np.zeros(pts.shape[:2], np.int32), np.zeros(pts.shape[:2] + (RGB,), np.float32)
             spread = np.zeros(pts.shape[:2], np.float32)
         out.append(Orthophoto(p, color, n.astype(np.int32), u0, v_top, res, spread))
     return out, calib, per_view
@@ -208,12 +195,12 @@ def _project(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int, height
     with np.errstate(divide="ignore", invalid="ignore"):
         xn = np.stack([pc[..., 0] / z, pc[..., 1] / z], -1).astype(np.float32)
     x, y = K[0, 0] * xn[..., 0] + K[0, 2], K[1, 1] * xn[..., 1] + K[1, 2]
-    inside = (z > 0.1) & (x >= 0) & (x <= width - 1) & (y >= 0) & (y <= height - 1)
+    inside = (z > _NEAR) & (x >= 0) & (x <= width - 1) & (y >= 0) & (y <= height - 1)
     return xn, x, y, z, inside
 
 
 def _window_in_view(pts: np.ndarray, w2c: np.ndarray, K: np.ndarray, width: int, height: int,
-                    step: int = 4) -> tuple[int, int, int, int] | None:
+                    step: int = _WINDOW_STEP) -> tuple[int, int, int, int] | None:
     """Rows r0:r1, columns c0:c1 of the grid ``pts`` (H, W, 3) that can fall inside the image: found on
     every ``step``-th grid point, widened by a step (the plane's visible part is convex, so no run of
     grid points inside the image is missed unless it is thinner than a step). None: none inside."""
@@ -233,13 +220,13 @@ def _sample(img: np.ndarray, f: Frame, v: _View, c: ColourCalibration, gray: boo
     x, y = _pixel_coords(v.xn, f, W, H, c)
     inside = v.ok & (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
     nch = 1 if gray or img.ndim == 2 else img.shape[2]
-    if inside.sum() < 20:
+    if inside.sum() < _MIN_SAMPLES:
         return np.full(v.ok.shape + (nch,), np.nan, np.float32)
     xi, yi = x[inside], y[inside]
     x0, y0 = int(np.floor(xi.min())), int(np.floor(yi.min()))
     x1, y1 = min(W, int(np.floor(xi.max())) + 2), min(H, int(np.floor(yi.max())) + 2)
     win = img[y0:y1, x0:x1]
-    if gray and win.ndim == 3:
+    if gray and win.ndim > 2:  # a colour window
         win = cv2.cvtColor(win, cv2.COLOR_RGB2GRAY)
     col = cv2.remap(win.astype(np.float32, copy=False), np.where(inside, x - x0, -1), np.where(inside, y - y0, -1),
                     cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=0)
@@ -251,16 +238,16 @@ def _sample(img: np.ndarray, f: Frame, v: _View, c: ColourCalibration, gray: boo
 
 
 def _disagreement(views: list[_Points], frames: Sequence[Frame], gray: dict[int, np.ndarray], c: ColourCalibration,
-                  n_grid: int) -> float:
-    """Mean per-pixel variance across views of the exposure-normalised brightness (pixels seen >= 3
-    times), accumulated with bincount over the seen points only."""
+                  n_grid: int, p: CalibrationConfig) -> float:
+    """Mean per-pixel variance across views of the exposure-normalised brightness (pixels seen >=
+    ``min_views`` times, at least ``min_px`` of them), accumulated with bincount over the seen points only."""
     idx, val = [], []
     for v in views:
         img = gray[v.frame]
         H, W = img.shape[:2]
         x, y = _pixel_coords(v.xn, frames[v.frame], W, H, c)
         inside = (x >= 0) & (x <= W - 1) & (y >= 0) & (y <= H - 1)
-        if inside.sum() < 20:
+        if inside.sum() < _MIN_SAMPLES:
             continue
         col = _remap_points(img, x[inside], y[inside])
         idx.append(v.idx[inside])
@@ -269,8 +256,8 @@ def _disagreement(views: list[_Points], frames: Sequence[Frame], gray: dict[int,
         return float("nan")
     i, x = np.concatenate(idx), np.concatenate(val).astype(np.float64)
     n = np.bincount(i, minlength=n_grid)
-    many = n >= 3
-    if many.sum() < 100:
+    many = n >= p.min_views
+    if many.sum() < p.min_px:
         return float("nan")
     s1, s2 = np.bincount(i, x, n_grid)[many], np.bincount(i, x * x, n_grid)[many]
     mean = s1 / n[many]
@@ -278,14 +265,14 @@ def _disagreement(views: list[_Points], frames: Sequence[Frame], gray: dict[int,
 
 
 def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[int, np.ndarray],
-               p: OrthoParams) -> ColourCalibration:
-    """Coordinate search of focal scale, then shift, then scale again, on the two planes seen most
-    (<= 12 views each, every other grid pixel)."""
+               p: CalibrationConfig) -> ColourCalibration:
+    """Coordinate search of focal scale, then shift, then scale again, on the ``planes`` planes seen most
+    (<= ``max_views`` views each, every other grid pixel)."""
     seen = [sum(int(v.ok.sum()) for v in vs) for vs in views]
     use: list[tuple[list[_Points], int]] = []
-    for i in np.argsort(seen)[::-1][:2]:
-        vs = sorted(views[i], key=lambda v: -int(v.ok.sum()))[:12]
-        if len(vs) >= 3:
+    for i in np.argsort(seen)[::-1][:p.planes]:
+        vs = sorted(views[i], key=lambda v: -int(v.ok.sum()))[:p.max_views]
+        if len(vs) >= p.min_views:
             sub = [v.every_other() for v in vs]
             width = max(v.c0 + v.ok.shape[1] for v in sub)
             pts = []
@@ -298,7 +285,7 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
     gray = {v.frame: cv2.cvtColor(images[v.frame], cv2.COLOR_RGB2GRAY).astype(np.float32) for vs, _ in use for v in vs}
 
     def cost(c: ColourCalibration) -> float:
-        vals = [_disagreement(vs, frames, gray, c, n_grid) for vs, n_grid in use]
+        vals = [_disagreement(vs, frames, gray, c, n_grid, p) for vs, n_grid in use]
         vals = [v for v in vals if np.isfinite(v)]
         return float(np.mean(vals)) if vals else float("inf")
 
@@ -306,17 +293,17 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
     best, best_cost = ColourCalibration(), base
     lo, hi = p.scale_range
     r = p.shift_range_px
+    fine = (-p.fine_shift_px, 0, p.fine_shift_px)
     # a coarse pass over the whole ranges, then a local one around the best (also when the best is
     # still the identity: re-running the coarse grids there only repeats evaluations)
     for step, coarse in (("scale", True), ("shift", True), ("scale", False), ("shift", False)):
         if step == "scale":
-            cands = [ColourCalibration(s, best.dx, best.dy) for s in np.linspace(lo, hi, 15)] if coarse else \
-                [ColourCalibration(best.scale + d, best.dx, best.dy) for d in (-0.02, -0.01, 0.01, 0.02)]
+            cands = [ColourCalibration(s, best.dx, best.dy) for s in np.linspace(lo, hi, p.scale_steps)] if coarse else \
+                [ColourCalibration(best.scale + d, best.dx, best.dy) for d in p.fine_scales]
         else:
             cands = [ColourCalibration(best.scale, best.dx + dx, best.dy + dy)
-                     for dx in np.linspace(-r, r, 5) for dy in np.linspace(-r, r, 5)] if coarse else \
-                [ColourCalibration(best.scale, best.dx + dx, best.dy + dy) for dx in (-3, 0, 3) for dy in (-3, 0, 3)
-                 if dx or dy]
+                     for dx in np.linspace(-r, r, p.shift_steps) for dy in np.linspace(-r, r, p.shift_steps)] if coarse else \
+                [ColourCalibration(best.scale, best.dx + dx, best.dy + dy) for dx in fine for dy in fine if dx or dy]
         for c in cands:
             v = cost(c)
             if v < best_cost:
@@ -329,8 +316,7 @@ def _calibrate(views: list[list[_View]], frames: Sequence[Frame], images: dict[i
 def _depth_edges(depth: np.ndarray, jump: float) -> np.ndarray:
     """Pixels at a depth jump over ``jump`` (3x3 max - min) or without a surface."""
     d = np.where(depth > 0, depth, 0.0).astype(np.float32)
-    k = np.ones((3, 3), np.uint8)
-    return ((cv2.dilate(d, k) - cv2.erode(d, k)) > jump) | (d <= 0)
+    return ((cv2.dilate(d, NEIGHBOURS) - cv2.erode(d, NEIGHBOURS)) > jump) | (d <= 0)
 
 
 def _edge_distance(depth: np.ndarray, jump: float, edge: np.ndarray | None = None) -> np.ndarray:
@@ -353,7 +339,7 @@ def _away_from_edges(depth: np.ndarray, px: int, jump: float, edge: np.ndarray |
 
 def _pick_views(planes: Sequence[Plane], frames: Sequence[Frame], grids: list[np.ndarray], min_cos: float,
                 max_views: int) -> list[set[int]]:
-    """Per plane, the best ``max_views`` frames, scored on a 25-point sample of the plane (in front of
+    """Per plane, the best ``max_views`` frames, scored on a 5 x 5 sample of the plane (in front of
     the camera, inside the image) times the cosine between view ray and plane normal."""
     centers = np.array([f.c2w[:3, 3] for f in frames])
     w2cs = np.array([f.w2c for f in frames])
@@ -362,13 +348,14 @@ def _pick_views(planes: Sequence[Plane], frames: Sequence[Frame], grids: list[np
     out = []
     for p, pts in zip(planes, grids):
         h, w = pts.shape[:2]
-        sample = pts[np.ix_(np.linspace(0, h - 1, 5).astype(int), np.linspace(0, w - 1, 5).astype(int))].reshape(-1, 3)
+        sample = pts[np.ix_(np.linspace(0, h - 1, _PICK_GRID).astype(int),
+                            np.linspace(0, w - 1, _PICK_GRID).astype(int))].reshape(-1, pts.shape[-1])
         pc = np.einsum("fij,sj->fsi", w2cs[:, :3, :3], sample) + w2cs[:, None, :3, 3]
         z = pc[..., 2]
         with np.errstate(divide="ignore", invalid="ignore"):
             x = Ks[:, None, 0, 0] * pc[..., 0] / z + Ks[:, None, 0, 2]
             y = Ks[:, None, 1, 1] * pc[..., 1] / z + Ks[:, None, 1, 2]
-        inside = (z > 0.1) & (x >= 0) & (x < size[:, None, 0]) & (y >= 0) & (y < size[:, None, 1])
+        inside = (z > _NEAR) & (x >= 0) & (x < size[:, None, 0]) & (y >= 0) & (y < size[:, None, 1])
         ray = sample[None] - centers[:, None]
         cos = -(ray @ p.n) / np.maximum(np.linalg.norm(ray, axis=-1), 1e-9)
         scores = (cos * (inside & (cos >= min_cos))).sum(1)

@@ -13,8 +13,15 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from ...config.heuristic import PlanesConfig
 from ...data.mesh import TriMesh
 from ...geometry import horizontal_right
+
+_HALF_TURN = 180.0  # deg: a plane's normal direction is taken modulo a half turn (either sign)
+_HALF_TURN_BINS = 180  # the direction histogram's 1-degree bins over [0, 180)
+_GAUSS_PAD = 4  # sigmas: the refit's density histogram is padded this far for its Gaussian
+_MIN_POINTS = 3  # fewer points fix no direction
+_PIECE_CLOSE = np.ones((3, 3))  # grid cells touching across one empty cell (or at a corner) are one piece
 
 
 @dataclass
@@ -59,16 +66,16 @@ def _peaks(hist: np.ndarray, min_weight: float, min_sep: int, circular: bool) ->
     return taken
 
 
-def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 0.3, angle_tol_deg: float = 12.0,
-                    offset_tol: float = 0.025, min_area: float = 0.08, cell: float = 0.04,
-                    view_dirs: np.ndarray | None = None, refit_deg: float = 3.0,
-                    refit_min_gain: float = 1.4, keep_share: float = 0.9) -> list[Plane]:
-    """Vertical planes of at least ``min_area`` m².
+def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *, max_tilt: float,
+                    min_area: float | None = None, view_dirs: np.ndarray | None = None) -> list[Plane]:
+    """Vertical planes (faces with |n_z| <= ``max_tilt``) of at least ``min_area`` m² (default ``cfg.min_area``).
 
-    A face belongs to a plane when its normal is within ``angle_tol_deg`` of the plane's horizontal
-    normal (either sign) and its centroid within ``offset_tol`` of the plane. Normals point towards
+    A face belongs to a plane when its normal is within ``cfg.angle_tol_deg`` of the plane's horizontal
+    normal (either sign) and its centroid within ``cfg.offset_tol`` of the plane. Normals point towards
     the cameras (``view_dirs``: per-face summed directions to cameras that saw it, else
-    ``cam_center``). Pieces of one plane separated by more than ``cell`` become separate planes."""
+    ``cam_center``). Pieces of one plane separated by more than ``cfg.cell`` become separate planes."""
+    min_area = cfg.min_area if min_area is None else min_area
+    angle_tol_deg, offset_tol, refit_deg = cfg.angle_tol_deg, cfg.offset_tol, cfg.refit_deg
     if mesh.n_faces == 0:
         return []
     nrm, area, cen = mesh.face_normals, mesh.face_areas, mesh.face_centroids
@@ -76,19 +83,19 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
     if not vert.any():
         return []
     # orientation-free direction histogram over [0, 180) degrees, 1-degree bins
-    theta = np.degrees(np.arctan2(nrm[:, 1], nrm[:, 0])) % 180.0
-    bins = np.floor(theta).astype(int) % 180
-    hist = np.bincount(bins[vert], weights=area[vert], minlength=180)
-    hist = ndimage.uniform_filter1d(hist, 5, mode="wrap")
+    theta = np.degrees(np.arctan2(nrm[:, 1], nrm[:, 0])) % _HALF_TURN
+    bins = np.floor(theta).astype(int) % _HALF_TURN_BINS
+    hist = np.bincount(bins[vert], weights=area[vert], minlength=_HALF_TURN_BINS)
+    hist = ndimage.uniform_filter1d(hist, cfg.direction_smooth_bins, mode="wrap")
     planes: list[Plane] = []
-    peaks = np.array(_peaks(hist, min_area / 5, 6, circular=True), float)
+    peaks = np.array(_peaks(hist, min_area / cfg.direction_peak_div, cfg.direction_min_sep_bins, circular=True), float)
     if not len(peaks):
         return []
     # each face goes to its nearest direction peak (a cabinet turned by 9 degrees is its own plane)
-    dist = np.abs((theta[:, None] - peaks[None] + 90.0) % 180.0 - 90.0)
+    dist = np.abs(_wrapped(theta[:, None] - peaks[None]))
     nearest = dist.argmin(1)
     for j, peak in enumerate(peaks):
-        dth = (theta - peak + 90.0) % 180.0 - 90.0
+        dth = _wrapped(theta - peak)
         near = vert & (nearest == j) & (np.abs(dth) <= angle_tol_deg)
         if area[near].sum() < min_area:
             continue
@@ -96,24 +103,26 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
         nd = np.array([np.cos(ang), np.sin(ang), 0.0])
         off = cen[near] @ nd
         lo = off.min()
-        nb = int((off.max() - lo) / 0.005) + 1
-        oh = np.bincount(((off - lo) / 0.005).astype(int), weights=area[near], minlength=nb)
-        oh = ndimage.uniform_filter1d(oh, max(1, int(offset_tol / 0.005)), mode="constant")
+        ob = cfg.offset_bin
+        nb = int((off.max() - lo) / ob) + 1
+        oh = np.bincount(((off - lo) / ob).astype(int), weights=area[near], minlength=nb)
+        oh = ndimage.uniform_filter1d(oh, max(1, int(offset_tol / ob)), mode="constant")
         idx_near = np.flatnonzero(near)
         used = np.zeros(len(cen), bool)  # a refitted plane may reach faces of the next offset peak
-        for pk in _peaks(oh, min_area / 10, int(2 * offset_tol / 0.005), circular=False):
-            d0 = lo + (pk + 0.5) * 0.005
+        for pk in _peaks(oh, min_area / cfg.offset_peak_div, int(2 * offset_tol / ob), circular=False):
+            d0 = lo + (pk + 0.5) * ob
             sel = idx_near[np.abs(off - d0) <= offset_tol]
             if area[sel].sum() < min_area:
                 continue
             n_fit = nd
             if refit_deg > 0:  # the face positions fix a wide plane's direction better than its (noisy, skewed) normals
-                n_fit, d_fit = fit_direction(cen[sel, :2], area[sel], nd, refit_deg, min_gain=refit_min_gain)
+                n_fit, d_fit = fit_direction(cen[sel, :2], area[sel], nd, cfg)
                 refit = None
                 if n_fit is not nd:
                     refit = idx_near[(np.abs(cen[idx_near] @ n_fit - d_fit) <= offset_tol) & ~used[idx_near]]
                 # straightened, the plane keeps (nearly) all it had; turned onto another surface, it does not
-                if refit is not None and area[np.intersect1d(refit, sel, assume_unique=True)].sum() >= keep_share * area[sel].sum():
+                if (refit is not None
+                        and area[np.intersect1d(refit, sel, assume_unique=True)].sum() >= cfg.refit_keep_share * area[sel].sum()):
                     sel = refit
                 else:
                     n_fit = nd
@@ -121,7 +130,7 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
                 if area[sel].sum() < min_area:
                     continue
                 used[sel] = True
-            planes += _pieces(sel, cen, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])), cell, min_area)
+            planes += _pieces(sel, cen, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])), cfg.cell, min_area)
     # orient each plane's normal towards the cameras that see it
     out = []
     for p in planes:
@@ -136,30 +145,30 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, *, max_tilt: float = 
     return out
 
 
-def fit_direction(xy: np.ndarray, w: np.ndarray, nd: np.ndarray, max_angle_deg: float = 3.0,
-                  step_deg: float = 0.1, bin_m: float = 0.002, sigma_m: float = 0.003,
-                  min_extent: float = 1.0, min_gain: float = 1.4) -> tuple[np.ndarray, float]:
+def fit_direction(xy: np.ndarray, w: np.ndarray, nd: np.ndarray, cfg: PlanesConfig) -> tuple[np.ndarray, float]:
     """Horizontal normal and offset of the points ``xy`` (weights ``w``): of the directions within
-    ``max_angle_deg`` of ``nd``, the one along which their offsets are sharpest — the largest integral
-    of the squared offset density (2 mm bins smoothed by a 3 mm Gaussian), which every parallel layer
+    ``refit_deg`` of ``nd`` (``refit_step_deg`` apart), the one along which their offsets are sharpest — the
+    largest integral of the squared offset density (``refit_bin`` bins smoothed by a ``refit_sigma``
+    Gaussian), which every parallel layer
     (wall, door leaf in front of it) raises only when each is sharp; the offset is the density's peak.
 
     Why: a curved appliance door beside a flat cabinet run skews the normals' mean by a degree, which
     over 2.5 m moves the plane's far end by the offset tolerance; the flat faces' positions do not skew.
-    Points without an unbroken stretch of ``min_extent`` along the plane (pieces of several cabinets at
+    Points without an unbroken stretch of ``refit_min_extent`` along the plane (pieces of several cabinets at
     about the same offset do not count) give ``nd`` back (with the weighted mean offset): over a short
     piece, positions fix the direction no better than normals do, and separate pieces may lie on
-    slightly different planes. A turn must make the density at least ``min_gain`` times sharper than
+    slightly different planes. A turn must make the density at least ``refit_min_gain`` times sharper than
     along the normals' direction: on a real scan's flat walls and cabinets (RedKitchen) the best turn
     gains 1.14-1.35 and changes what is found there; on the tuning scenes' TSDF meshes, beside a curved
     fridge door and on skewed runs, 1.42-2.8 (the default 1.4 lies between the two)."""
-    if len(xy) < 3 or _longest_run(xy @ np.array([-nd[1], nd[0]]), 0.04) < min_extent:
+    max_angle_deg, bin_m, sigma_m = cfg.refit_deg, cfg.refit_bin, cfg.refit_sigma
+    if len(xy) < _MIN_POINTS or _longest_run(xy @ np.array([-nd[1], nd[0]]), cfg.refit_run_step) < cfg.refit_min_extent:
         return nd, float(np.average(xy @ nd[:2], weights=w))
     a0 = np.arctan2(nd[1], nd[0])
-    angs = a0 + np.radians(np.arange(-max_angle_deg, max_angle_deg + 1e-9, step_deg))
+    angs = a0 + np.radians(np.arange(-max_angle_deg, max_angle_deg + 1e-9, cfg.refit_step_deg))
     dirs = np.stack([np.cos(angs), np.sin(angs)], 1)                    # (A, 2)
     off = xy @ dirs.T                                                   # (N, A)
-    pad = int(np.ceil(4 * sigma_m / bin_m))
+    pad = int(np.ceil(_GAUSS_PAD * sigma_m / bin_m))
     lo = off.min(0) - pad * bin_m
     idx = ((off - lo) / bin_m).astype(int)
     nb = int(idx.max()) + pad + 1
@@ -168,11 +177,16 @@ def fit_direction(xy: np.ndarray, w: np.ndarray, nd: np.ndarray, max_angle_deg: 
     hist = ndimage.gaussian_filter1d(hist, sigma_m / bin_m, axis=1, mode="constant")
     sharp = (hist ** 2).sum(1)
     k = int(np.argmax(sharp))
-    if sharp[k] < min_gain * sharp[len(angs) // 2]:  # not clearly sharper than along the normals: keep them
+    if sharp[k] < cfg.refit_min_gain * sharp[len(angs) // 2]:  # not clearly sharper than along the normals: keep them
         return nd, float(np.average(xy @ nd[:2], weights=w))
     b = int(np.argmax(hist[k]))
     n2 = dirs[k]
     return np.array([n2[0], n2[1], 0.0]), float(lo[k] + (b + 0.5) * bin_m)
+
+
+def _wrapped(deg: np.ndarray) -> np.ndarray:
+    """Angle differences (deg) wrapped into [-90, 90): directions modulo a half turn."""
+    return (deg + _HALF_TURN / 2) % _HALF_TURN - _HALF_TURN / 2
 
 
 def _longest_run(t: np.ndarray, step: float) -> float:
@@ -198,7 +212,7 @@ def _pieces(sel: np.ndarray, cen: np.ndarray, area: np.ndarray, n: np.ndarray, d
     iv = np.floor((pv - pv.min()) / cell).astype(int)
     grid = np.zeros((iv.max() + 1, iu.max() + 1), bool)
     grid[iv, iu] = True
-    lab, k = ndimage.label(ndimage.binary_closing(grid, np.ones((3, 3)), border_value=0) | grid, np.ones((3, 3)))
+    lab, k = ndimage.label(ndimage.binary_closing(grid, _PIECE_CLOSE, border_value=0) | grid, _PIECE_CLOSE)
     fl = lab[iv, iu]
     out = []
     for j in range(1, k + 1):

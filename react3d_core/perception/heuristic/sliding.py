@@ -4,39 +4,17 @@ A pair of sliding doors shows as two parallel, equally tall fronts whose planes 
 (one door stands a few centimetres in front of the other) and whose outlines meet or overlap a
 little where one slides behind the other. Hinged doors and drawers of one run are coplanar, so a
 plane offset between side-by-side fronts is the evidence. Each door of such a pair slides in its
-front plane (prismatic along the front's horizontal in-plane direction) towards the other one.
+front plane (prismatic along the front's horizontal in-plane direction) towards the other one. The
+thresholds are ``perception.heuristic.sliding``.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import SlidingConfig
 from ...data.parts import Articulation
 from .fronts import Front
-
-
-_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic.sliding_*)
-
-
-@dataclass(frozen=True)
-class SlidingRules:
-    """Thresholds of the two-track rule, built from ``HeuristicConfig`` by ``sliding_from_config``."""
-
-    track_offset: tuple[float, float] = _H.sliding_track_offset  # plane offset between the two doors (m)
-    max_overlap: float = _H.sliding_max_overlap  # the doors' outlines overlap by at most this (m) ...
-    max_gap: float = _H.sliding_max_gap          # ... or leave at most this gap between them (m)
-    min_height_overlap: float = _H.sliding_min_height_overlap  # share of the smaller height the two doors have in common
-    min_parallel: float = _H.sliding_min_parallel  # |cos| between the fronts' normals
-
-
-def sliding_from_config(cfg: HeuristicConfig) -> SlidingRules:
-    """The two-track rule's thresholds from the pipeline config (the one place they are built)."""
-    return SlidingRules(track_offset=tuple(cfg.sliding_track_offset), max_overlap=cfg.sliding_max_overlap,
-                        max_gap=cfg.sliding_max_gap, min_height_overlap=cfg.sliding_min_height_overlap,
-                        min_parallel=cfg.sliding_min_parallel)
 
 
 def _u_overlap(f: Front, g: Front) -> float:
@@ -45,7 +23,7 @@ def _u_overlap(f: Front, g: Front) -> float:
     return min(c + g.w / 2, f.extent_u[1]) - max(c - g.w / 2, f.extent_u[0])
 
 
-def sliding_partner(f: Front, fronts: list[Front], r: SlidingRules) -> Front | None:
+def sliding_partner(f: Front, fronts: list[Front], r: SlidingConfig) -> Front | None:
     """The front ``f`` slides against, or None: parallel, a track in front of or behind it, as tall as
     it, and meeting it side by side with a small overlap or gap (not one inside the other)."""
     best, best_ov = None, -np.inf
@@ -66,7 +44,7 @@ def sliding_partner(f: Front, fronts: list[Front], r: SlidingRules) -> Front | N
     return best
 
 
-def mark_sliding(fronts: list[Front], rules: SlidingRules = SlidingRules()) -> int:
+def mark_sliding(fronts: list[Front], rules: SlidingConfig = SlidingConfig()) -> int:
     """Re-type fronts that have a sliding partner as sliding doors (kind ``sliding``): prismatic along
     the front's horizontal in-plane direction ``u``, towards the partner. Returns how many."""
     partner = {id(f): sliding_partner(f, fronts, rules) for f in fronts}
@@ -80,7 +58,7 @@ def mark_sliding(fronts: list[Front], rules: SlidingRules = SlidingRules()) -> i
         centre = np.array([centre[0], centre[1], 0.5 * sum(f.extent_v)])
         f.kind = "sliding"
         f.articulation = Articulation(joint_type="prismatic", axis=towards * f.u, origin=centre, lower=0.0,
-                                      upper=max(0.05, f.w - max(0.0, _u_overlap(f, g))),
+                                      upper=max(rules.min_travel, f.w - max(0.0, _u_overlap(f, g))),
                                       limit_source="heuristic")
         n += 1
     return n

@@ -6,45 +6,25 @@ splash-back, and its sockets, switches and tile joints look like handles and sea
 A wall cabinet hangs well above the worktop; an appliance standing on the worktop (a microwave) stands
 in front of the wall, with the worktop ending at its door. So a front is dropped when a horizontal,
 upward-facing surface runs level with its bottom edge (within ``band``), above ``min_z``, and covers at
-least ``cover`` of a strip ``reach`` deep in front of it.
+least ``cover`` of a strip ``reach`` deep in front of it (``perception.heuristic.splashback``).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import SplashbackConfig
 from ...data.mesh import TriMesh
 from .fronts import Front
 
-_H = HeuristicConfig()
 
-
-@dataclass(frozen=True)
-class SplashbackRules:
-    """Built from ``HeuristicConfig`` (perception.heuristic.splashback_*)."""
-
-    min_z: float = _H.splashback_min_z        # m: a worktop is above this (a floor in front of a base unit is not)
-    band: float = _H.splashback_band          # m: the surface is this close to the front's bottom edge in height
-    reach: tuple[float, float] = tuple(_H.splashback_reach)  # m in front of the front: the strip examined
-    cover: float = _H.splashback_cover        # share of the strip's area the surface must cover
-
-
-def splashback_from_config(cfg: HeuristicConfig) -> SplashbackRules | None:
-    """The rules, or None when ``perception.heuristic.splashback`` is off."""
-    if not cfg.splashback:
-        return None
-    return SplashbackRules(cfg.splashback_min_z, cfg.splashback_band, tuple(cfg.splashback_reach), cfg.splashback_cover)
-
-
-def on_worktop(fronts: list[Front], mesh: TriMesh, rules: SplashbackRules) -> list[bool]:
-    """Per front: does it stand on a worktop, flush with the wall behind it (see module docstring)?"""
+def on_worktop(fronts: list[Front], mesh: TriMesh, rules: SplashbackConfig) -> list[bool]:
+    """Per front: does it stand on a worktop, flush with the wall behind it (see module docstring)?
+    (The rule itself, whether or not ``rules.enabled``.)"""
     if not fronts:
         return []
     n = mesh.face_normals
-    up = n[:, 2] > 0.7  # a scanned worktop is noisy and cluttered: its faces tilt
+    up = n[:, 2] > rules.min_up  # a scanned worktop is noisy and cluttered: its faces tilt
     cen, area = mesh.face_centroids[up], mesh.face_areas[up]
     out = []
     for f in fronts:

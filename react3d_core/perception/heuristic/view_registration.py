@@ -19,7 +19,7 @@ counted per blur-sized cell, holds what a view's texture does not determine (a p
 vertical lines says nothing about the vertical shift). After every round the corrections lose their
 median drift, and at the end a view keeps its correction only when it fits clearly better than the
 scene calibration. A scan whose colour is registered ends where it started (its views already agree).
-Opt-in (``register_sigmas_px``); docs/perception.md has what it gains and costs.
+Opt-in (``perception.heuristic.registration.sigmas_px``); docs/perception.md has what it gains and costs.
 """
 
 from __future__ import annotations
@@ -30,28 +30,17 @@ from dataclasses import dataclass, replace
 import cv2
 import numpy as np
 
-from ...config.heuristic import HeuristicConfig
+from ...config.heuristic import RegistrationConfig
 from ...data.frames import Frame
 from .colour_sampling import ColourCalibration, Points, nanmedian, pixel_coords, remap_points
+from .constants import COLOUR_NDIM, MAD_SIGMA, REFERENCE_WIDTH_PX
 
-
-_H = HeuristicConfig()  # defaults and descriptions live in the config (perception.heuristic.register_*)
-
-
-@dataclass(frozen=True)
-class RegistrationParams:
-    """Per-view registration parameters (built from ``HeuristicConfig.register_*``)."""
-
-    sigmas_px: tuple[float, ...] = tuple(_H.register_sigmas_px)  # blur per level, px at 640 px width; () = off
-    rounds: int = 2                  # per level: re-fuse the median, then ``iters`` Gauss-Newton steps per view
-    iters: int = 3
-    prior_scale: float = _H.register_prior_scale  # prior std of a view's focal scale around the scene calibration
-    prior_shift_px: float = _H.register_prior_shift_px  # prior std of its shift (px at 640 px width)
-    min_views: int = 3               # a grid pixel takes part when this many views see it
-    min_points: int = 2000           # a view with fewer such pixels keeps the scene calibration (8 mm grid: ~0.13 m²)
-    band: float = 2.0                # signal: log brightness blurred at sigma less blurred at band * sigma (0: less the plane mean)
-    reach: float = 2.0               # points nearer than reach * (band or 1) * sigma to a depth jump are left out
-    min_gain: float = 0.1            # a view keeps its correction when it cuts its disagreement by this fraction
+_LOG_OFFSET = 8.0  # grey levels added before the log: dark pixels' noise must not blow up
+_SOBEL = 3  # Sobel kernel size ...
+_SOBEL_SUM = 8.0  # ... whose weights sum to 8 times the gradient
+_MIN_SCALE = 1e-4  # floor of the residuals' robust scale (a view that matches exactly)
+_HUBER_K = 1.345  # Huber's constant: 95 % efficiency on normal residuals
+_CELL_HASH = 100_003  # a prime above any cell column count: (row, column) -> one integer
 
 
 @dataclass
@@ -67,23 +56,24 @@ class _Seen:
 
 def register_views(planes_points: Sequence[Sequence[Points]], grid_sizes: Sequence[int], frames: Sequence[Frame],
                    images: dict[int, np.ndarray], calib: ColourCalibration,
-                   p: RegistrationParams = RegistrationParams()) -> dict[int, ColourCalibration]:
+                   p: RegistrationConfig = RegistrationConfig()) -> dict[int, ColourCalibration]:
     """Each frame's colour correction (frames not registered keep ``calib``). ``planes_points[i]``:
     every view's seen points of plane i's sub-sampled grid (``grid_sizes[i]`` pixels)."""
     seen = _by_frame(planes_points)
     cur = {f: calib for f in seen}
     if not p.sigmas_px or len(seen) < 2:
         return cur
-    logs = {f: np.log(_gray(images[f]) + 8.0) for f in seen}
+    logs = {f: np.log(_gray(images[f]) + _LOG_OFFSET) for f in seen}
     for sigma in p.sigmas_px:
         blur, grads = {}, {}
         for f, g in logs.items():
-            s = sigma * g.shape[1] / 640.0
+            s = sigma * g.shape[1] / REFERENCE_WIDTH_PX
             b = cv2.GaussianBlur(g, (0, 0), s)
             if p.band > 0:
                 b = b - cv2.GaussianBlur(g, (0, 0), p.band * s)
             blur[f] = b
-            grads[f] = (cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=3) / 8.0, cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=3) / 8.0)
+            grads[f] = (cv2.Sobel(b, cv2.CV_32F, 1, 0, ksize=_SOBEL) / _SOBEL_SUM,
+                        cv2.Sobel(b, cv2.CV_32F, 0, 1, ksize=_SOBEL) / _SOBEL_SUM)
         for _ in range(p.rounds):
             lv = (p.reach * max(p.band, 1.0) * sigma, p.band <= 0)
             refs = _medians(seen, frames, blur, cur, grid_sizes, p.min_views, lv)
@@ -100,7 +90,7 @@ def register_views(planes_points: Sequence[Sequence[Points]], grid_sizes: Sequen
 
 
 def _clearly_better(pts: "_Seen", f: Frame, img: np.ndarray, refs: list[np.ndarray], c: ColourCalibration,
-                    base: ColourCalibration, p: RegistrationParams, lv: tuple[float, bool]) -> bool:
+                    base: ColourCalibration, p: RegistrationConfig, lv: tuple[float, bool]) -> bool:
     """Whether ``c`` fits the medians ``refs`` by ``p.min_gain`` better than ``base`` (robust cost on the
     points seen under both)."""
     target = _targets(pts, refs)
@@ -138,7 +128,7 @@ def _recentred(cur: dict[int, ColourCalibration], calib: ColourCalibration) -> d
 
 
 def _gray(img: np.ndarray) -> np.ndarray:
-    g = cv2.cvtColor(img, cv2.COLOR_RGB2GRAY) if img.ndim == 3 else img
+    g = cv2.cvtColor(img, cv2.COLOR_RGB2GRAY) if img.ndim == COLOUR_NDIM else img
     return g.astype(np.float32)
 
 
@@ -167,7 +157,7 @@ def _sample(pts: _Seen, f: Frame, img: np.ndarray, c: ColourCalibration, lv: tup
     reach, centre = lv
     H, W = img.shape[:2]
     x, y = pixel_coords(pts.xn, f, W, H, c)
-    inside = (x >= 1) & (x <= W - 2) & (y >= 1) & (y <= H - 2) & (pts.edge_px >= reach * W / 640.0)
+    inside = (x >= 1) & (x <= W - 2) & (y >= 1) & (y <= H - 2) & (pts.edge_px >= reach * W / REFERENCE_WIDTH_PX)
     val = np.full(len(x), np.nan, np.float32)
     val[inside] = remap_points(img, x[inside], y[inside])
     if centre:
@@ -217,12 +207,12 @@ def _with(c: ColourCalibration, th: np.ndarray) -> ColourCalibration:
 
 
 def _mad_scale(e: np.ndarray) -> float:
-    return max(1.4826 * float(np.median(np.abs(e))), 1e-4)
+    return max(MAD_SIGMA * float(np.median(np.abs(e))), _MIN_SCALE)
 
 
 def _huber(e: np.ndarray, s: float) -> tuple[float, np.ndarray]:
     """Mean Huber cost of residuals ``e`` at scale ``s`` (in units of s²) and the Huber weights."""
-    k = 1.345 * s
+    k = _HUBER_K * s
     a = np.abs(e)
     w = np.where(a <= k, 1.0, k / np.maximum(a, 1e-12))
     cost = np.where(a <= k, 0.5 * a * a, k * (a - 0.5 * k))
@@ -230,7 +220,7 @@ def _huber(e: np.ndarray, s: float) -> tuple[float, np.ndarray]:
 
 
 def _gauss_newton(pts: _Seen, f: Frame, img: np.ndarray, grads: tuple[np.ndarray, np.ndarray], refs: list[np.ndarray],
-                  c: ColourCalibration, prior: ColourCalibration, sigma: float, p: RegistrationParams,
+                  c: ColourCalibration, prior: ColourCalibration, sigma: float, p: RegistrationConfig,
                   lv: tuple[float, bool]) -> ColourCalibration:
     """``c`` moved onto the medians ``refs`` by up to ``p.iters`` Gauss-Newton steps; kept when the
     robust disagreement (on the points seen before and after) does not drop."""
@@ -240,7 +230,7 @@ def _gauss_newton(pts: _Seen, f: Frame, img: np.ndarray, grads: tuple[np.ndarray
         return c
     H, W = img.shape[:2]
     intr = f.intrinsics if (f.intrinsics.width, f.intrinsics.height) == (W, H) else f.intrinsics.scaled(W, H)
-    k = W / 640.0
+    k = W / REFERENCE_WIDTH_PX
     prior_std = np.array([p.prior_scale, p.prior_shift_px, p.prior_shift_px])
     P = np.diag(1.0 / prior_std ** 2)
     t0 = _theta(prior)
@@ -267,7 +257,7 @@ def _gauss_newton(pts: _Seen, f: Frame, img: np.ndarray, grads: tuple[np.ndarray
         # observations as there are blur-sized (2 sigma) cells under the points, so that the prior
         # still holds a view whose texture leaves a direction open
         cell = 2.0 * sigma * k
-        n_cells = len(np.unique(np.floor(x[ok] / cell).astype(np.int64) * 100_003 + np.floor(y[ok] / cell).astype(np.int64)))
+        n_cells = len(np.unique(np.floor(x[ok] / cell).astype(np.int64) * _CELL_HASH + np.floor(y[ok] / cell).astype(np.int64)))
         weight = n_cells / (ok.sum() * s2)
         Jw = J * w[:, None]
         A = weight * (Jw.T @ J) + P
@@ -276,13 +266,13 @@ def _gauss_newton(pts: _Seen, f: Frame, img: np.ndarray, grads: tuple[np.ndarray
             step = -np.linalg.solve(A, b)
         except np.linalg.LinAlgError:
             break
-        lim = np.array([0.02, sigma, sigma])
+        lim = np.array([p.max_scale_step, sigma, sigma])
         step = np.clip(step, -lim, lim)
         th = th + step
         val, ok, x, y = evaluate(_with(c, th))
         if ok.sum() < p.min_points:
             return c
-        if np.abs(step[1:]).max() < 0.05 and abs(step[0]) < 1e-4:
+        if np.abs(step[1:]).max() < p.converged_shift_px and abs(step[0]) < p.converged_scale:
             break
     costs = _costs(val, ok, start_val, start_ok, target, p.min_points)
     return _with(c, th) if costs is not None and costs[0] < costs[1] else c

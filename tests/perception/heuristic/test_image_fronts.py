@@ -9,15 +9,16 @@ import numpy as np
 import pytest
 
 from react3d_core.camera import look_at
+from react3d_core.config.heuristic import (ClutterConfig, FloorConfig, HandleConfig, HeuristicConfig, PlanesConfig,
+                                           SeamConfig)
 from react3d_core.data.frames import Frame, ImageRef, Intrinsics
 from react3d_core.data.mesh import TriMesh
 from react3d_core.perception.heuristic.facets import planar_facets
-from react3d_core.perception.heuristic.front_cells import CellParams, find_handles, split_cells
+from react3d_core.perception.heuristic.front_cells import find_handles, split_cells
 from react3d_core.perception.heuristic.fronts import find_fronts
-from react3d_core.perception.heuristic.image_fronts import ImageFrontParams, find_image_fronts
-from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, OrthoParams, _nanmedian
+from react3d_core.perception.heuristic.image_fronts import find_image_fronts
+from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, _nanmedian
 from react3d_core.perception.heuristic.planes import Plane, vertical_planes
-from react3d_core.perception.heuristic.view_registration import RegistrationParams
 from react3d_core.raster import Rasterizer
 from react3d_core.synthetic.render import RayCaster
 
@@ -61,7 +62,7 @@ def test_vertical_planes_split_l_shape_and_turned_cabinet() -> None:
     unit = _grid_mesh(0.0, 0.8, 0.5, 1.0, 0.0, 0.02, grey)
     R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
     unit = TriMesh(unit.vertices @ R.T + [1.0, 3.5, 0.0], unit.faces, unit.colors)
-    planes = vertical_planes(_merge(back, side, unit), np.array([1.0, 1.0, 1.2]), min_area=0.2)
+    planes = vertical_planes(_merge(back, side, unit), np.array([1.0, 1.0, 1.2]), PlanesConfig(), max_tilt=0.3, min_area=0.2)
     normals = sorted((tuple(np.round(p.n, 2)), round(p.area, 1)) for p in planes)
     assert len(planes) == 3, normals
     by_area = sorted(planes, key=lambda p: -p.area)
@@ -93,7 +94,7 @@ def test_cells_split_at_seams_and_between_handles() -> None:
         img[15:19, c0:c0 + 40] = [1.8, 1.8, 1.8]
     o = _ortho(img)
     cov = np.ones((h, w), bool)
-    p = CellParams()
+    p = HeuristicConfig()
     handles = find_handles(o, cov, p)
     assert len(handles) == 3 and all(hd.horizontal for hd in handles)
     cells = sorted(split_cells(o, cov, handles, p), key=lambda c: c.c0)
@@ -191,7 +192,7 @@ def _registration_errors(res, per_view: list[tuple[float, float, float]], W: int
     return np.linalg.norm(errs - errs.mean(0, keepdims=True), axis=-1).max(1)
 
 
-_REGISTER = ImageFrontParams(ortho=OrthoParams(register=RegistrationParams(sigmas_px=(12.0, 6.0, 3.0, 1.5))))
+_REGISTER = HeuristicConfig(registration={"sigmas_px": (12.0, 6.0, 3.0, 1.5)})
 
 
 def test_each_view_is_registered_onto_the_others() -> None:
@@ -200,7 +201,7 @@ def test_each_view_is_registered_onto_the_others() -> None:
     still split; with registration off the views stay several pixels apart (the check can fail)."""
     per_view = [(1.0, 0.0, 0.0), (0.97, 5.0, -3.0), (1.03, -6.0, 2.0), (1.0, 3.0, 6.0), (0.98, -4.0, -5.0)]
     mesh, frames, images = _seamless_cabinet_scene(per_view=per_view)
-    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], params=_REGISTER)
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], cfg=_REGISTER)
     assert sorted(res.registration) == list(range(5))
     err = _registration_errors(res, per_view)
     assert err.max() < 0.6, err
@@ -212,20 +213,24 @@ def test_each_view_is_registered_onto_the_others() -> None:
 def test_registration_leaves_registered_colour_alone() -> None:
     """Views that already agree end where they started (within a tenth of a pixel)."""
     mesh, frames, images = _seamless_cabinet_scene()
-    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], params=_REGISTER)
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], cfg=_REGISTER)
     assert _registration_errors(res, [(1.0, 0.0, 0.0)] * 5).max() < 0.1
     for c in res.registration.values():
         assert abs(c.scale - 1) < 1e-3 and abs(c.dx) < 0.2 and abs(c.dy) < 0.2
 
 
 def test_orthophoto_params_are_in_the_config() -> None:
+    """An override of ``perception.heuristic.ortho.resolution`` reaches the orthophotos the image path fuses."""
     from react3d_core.config import PipelineConfig
-    from react3d_core.perception.heuristic.image_fronts import params_from_config
 
-    cfg = PipelineConfig().with_overrides({"perception": {"heuristic": {"ortho_resolution": 0.006, "seam_span": 0.5}}})
-    p = params_from_config(cfg.perception.heuristic)
-    assert p.ortho.resolution == 0.006 and p.cells.seam_span == 0.5
-    assert OrthoParams().resolution == PipelineConfig().perception.heuristic.ortho_resolution
+    cfg = PipelineConfig().with_overrides({"perception": {"heuristic": {"ortho": {"resolution": 0.006},
+                                                                        "seams": {"span": 0.5}}}})
+    h = cfg.perception.heuristic
+    assert h.ortho.resolution == 0.006 and h.seams.span == 0.5
+    assert PipelineConfig().perception.heuristic.ortho.resolution == 0.004
+    mesh, frames, images = _seamless_cabinet_scene()
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], cfg=h)
+    assert res.orthophotos and {o.res for o in res.orthophotos} == {0.006}
 
 
 def test_frames_without_colour_fall_back_to_the_mesh_with_one_warning(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
@@ -257,7 +262,7 @@ def test_split_between_handles_ends_on_overlapping_bars() -> None:
     c = Cell(0, 0, 300, 200, [h1, h2])
     ev = np.zeros((200, 300), bool)
     ev[:, 150] = True
-    cells = _split_handles(c, ev, ev, np.ones((200, 300), bool), 20, np.ones((200, 300)), CellParams())
+    cells = _split_handles(c, ev, ev, np.ones((200, 300), bool), 20, np.ones((200, 300)), SeamConfig())
     assert sum(len(x.handles) for x in cells) == 2 and all(x.handles for x in cells)
 
 
@@ -272,7 +277,7 @@ def test_dip_scores_hand_computed() -> None:
     g[:, 45] = 0.5
     cov = np.ones((40, 60), bool)
     cov[:30, 45] = False                       # column 45: 10 of 40 pixels covered
-    z = _dip_scores(g, cov, 0, 5, CellParams())
+    z = _dip_scores(g, cov, 0, 5, SeamConfig())
     assert z[30] == pytest.approx(100.0)
     assert z[45] == 0.0 and np.count_nonzero(z) == 1
 
@@ -304,7 +309,7 @@ def test_straight_seam_found_through_wood_grain() -> None:
         return _ortho(np.repeat(np.median(views, 0)[:, :, None], 3, 2), res)
 
     cov = np.ones((h, w), bool)
-    p = CellParams()
+    p = HeuristicConfig()
     assert len(split_cells(fused(fine), cov, [], p)) == 1
     seam = fine.copy()
     seam[:, 100 * ss:102 * ss] *= 0.7
@@ -333,13 +338,13 @@ def test_colour_step_cuts_a_door_leaf_out_of_a_wall() -> None:
     rng = np.random.default_rng(1)
     wall = np.array([1.1, 1.15, 1.05], np.float32)
     img = np.tile(wall, (h, w, 1)) + rng.normal(0, 0.01, (h, w, 3)).astype(np.float32)
-    assert len(split_cells(_ortho(img), np.ones((h, w), bool), [], CellParams())) == 1
+    assert len(split_cells(_ortho(img), np.ones((h, w), bool), [], HeuristicConfig())) == 1
     img[:, 160:340] = np.array([0.55, 0.4, 0.3], np.float32) + rng.normal(0, 0.01, (h, 180, 3)).astype(np.float32)
     img[200:206, 300:330] = 1.6                # lever handle near the leaf's right edge
     o = _ortho(img)
     cov = np.ones((h, w), bool)
-    handles = find_handles(o, cov, CellParams())
-    cells = split_cells(o, cov, handles, CellParams())
+    handles = find_handles(o, cov, HeuristicConfig())
+    cells = split_cells(o, cov, handles, HeuristicConfig())
     leaf = [c for c in cells if c.handles]
     assert len(leaf) == 1 and abs(leaf[0].c0 - 160) <= 2 and abs(leaf[0].c1 - 340) <= 2
 
@@ -375,11 +380,12 @@ def test_clutter_share_against_the_cell_colour() -> None:
     band[:, :12] = True                                   # 12 of 40 columns: 0.3
     seen = np.ones((h, w), bool)
     none = np.zeros((h, w), bool)
-    assert _clutter_share(o, cell, band, seen, None) == pytest.approx(0.3)
-    assert _clutter_share(o, cell, band, seen, (0.12, none)) == pytest.approx(0.0)
+    min_px = ClutterConfig().median_min_px
+    assert _clutter_share(o, cell, band, seen, None, min_px) == pytest.approx(0.3)
+    assert _clutter_share(o, cell, band, seen, (0.12, none), min_px) == pytest.approx(0.0)
     img[:, :12] = [0.3, 0.3, 1.4]                         # a poster where the band is
     o = _ortho(img, 0.01)
-    assert _clutter_share(o, cell, band, seen, (0.12, none)) == pytest.approx(0.3)
+    assert _clutter_share(o, cell, band, seen, (0.12, none), min_px) == pytest.approx(0.3)
 
 
 def test_colour_step_beats_a_weaker_frame_line() -> None:
@@ -395,8 +401,8 @@ def test_colour_step_beats_a_weaker_frame_line() -> None:
     img[:, 116] *= 0.8                                    # the frame's shadow line
     o = _ortho(img, 0.004)
     cov = np.ones((h, w), bool)
-    on = CellParams(min_front=0.12, step_over_dip=True)
-    off = CellParams(min_front=0.12, step_over_dip=False)
+    on = HeuristicConfig(cells={"min_side": 0.12}, seams={"step_over_dip": True})
+    off = HeuristicConfig(cells={"min_side": 0.12}, seams={"step_over_dip": False})
     cuts_on = sorted({c.c0 for c in split_cells(o, cov, [], on)} - {0})
     cuts_off = sorted({c.c0 for c in split_cells(o, cov, [], off)} - {0})
     assert cuts_on and abs(cuts_on[0] - 100) <= 2, cuts_on
@@ -417,7 +423,7 @@ def test_enclosed_handle_shadows_hand_computed() -> None:
     seen[10:50, 80:86] = False   # vertical: 0.2 m tall, 0.03 m wide
     seen[20:22, 20:60] = False   # horizontal but 1 cm thin
     seen[70:75, 70:100] = False  # reaches the outline's bottom border
-    holes = enclosed_holes(seen, outline, 0.005)
+    holes = enclosed_holes(seen, outline, 0.005, HandleConfig().shadow_min_thick)
     expected = np.zeros((h, w), bool)
     expected[60:68, 20:60] = True
     assert np.array_equal(holes, expected)
@@ -432,7 +438,7 @@ def test_protrusion_map_grows_the_splat_by_one_pixel() -> None:
     cen = np.array([[0.1 + 0.002, -0.03, 0.2 - 0.1 - 0.002],      # pixel (row 25, col 25)
                     [0.05, -0.01, 0.1], [0.15, -0.03, 0.1]])
     nrm = np.array([[0.0, -1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 1.0, 0.0]])
-    m = protrusion_map(o, cen, nrm)
+    m = protrusion_map(o, cen, nrm, HandleConfig(), 0.0, PlanesConfig().offset_tol)
     expected = np.zeros((50, 60), bool)
     expected[24:27, 24:27] = True
     assert np.array_equal(m, expected)
@@ -448,8 +454,8 @@ def test_standing_bar_in_the_mesh_is_a_handle() -> None:
     cov = np.ones((h, w), bool)
     zs = 0.6 - (np.arange(30, 70) + 0.5) * res                     # rows 30-69
     cen = np.array([[(c + 0.5) * res, -0.03, z] for c in (50, 51) for z in zs])
-    bar = protrusion_map(o, cen, np.tile([0.0, -1.0, 0.0], (len(cen), 1)))
-    hs = find_handles(o, cov, CellParams(), None, bar, cov)
+    bar = protrusion_map(o, cen, np.tile([0.0, -1.0, 0.0], (len(cen), 1)), HandleConfig(), 0.0, PlanesConfig().offset_tol)
+    hs = find_handles(o, cov, HeuristicConfig(), None, bar, cov)
     assert len(hs) == 1 and not hs[0].horizontal
     assert hs[0].box == (49, 29, 53, 71)
 
@@ -478,7 +484,7 @@ def test_ridge_at_the_planes_end_is_no_handle() -> None:
     h, w, res = 150, 200, 0.004
     o = _ortho(np.ones((h, w, 3), np.float32), res=res)
     cov = np.ones((h, w), bool)
-    on, off = CellParams(side_cover=0.4), CellParams(side_cover=0.0)
+    on, off = HeuristicConfig(handles={"side_cover": 0.4}), HeuristicConfig(handles={"side_cover": 0.0})
     for c0, kept_with in ((0, False), (90, True)):
         bar = np.zeros((h, w), bool)
         bar[40:120, c0:c0 + 15] = True
@@ -501,9 +507,9 @@ def test_protrusion_is_measured_from_the_surface_around() -> None:
     bar = np.array([[(c + 0.5) * res, -0.015 - 0.03, 0.4 - (r + 0.5) * res] for c in (150, 151) for r in range(30, 70)])
     cen = np.concatenate([wall, bar])
     nrm = np.tile([0.0, -1.0, 0.0], (len(cen), 1))
-    plane = protrusion_map(o, cen, nrm)
+    plane = protrusion_map(o, cen, nrm, HandleConfig(), 0.0, PlanesConfig().offset_tol)
     assert plane[:, 100:].all() and not plane[:, :99].any()
-    m = protrusion_map(o, cen, nrm, win=0.12)
+    m = protrusion_map(o, cen, nrm, HandleConfig(), 0.12, PlanesConfig().offset_tol)
     assert m[30:70, 150:152].all()
     assert m.sum() == m[28:72, 148:154].sum() and m.sum() <= 44 * 6       # only the bar (closed, grown by 1 px)
 
@@ -536,9 +542,9 @@ def test_handle_found_from_its_shadow_alone() -> None:
     o = _ortho(img)
     o.n_views[110:118, 30:70] = 0  # 0.2 x 0.04 m, 0.11 m above the bottom edge
     cov = np.ones((h, w), bool)
-    p = CellParams()
+    p = HeuristicConfig()
     assert find_handles(o, cov, p) == []
-    hs = find_handles(o, cov, p, None, enclosed_holes(o.n_views > 0, cov, o.res), cov)
+    hs = find_handles(o, cov, p, None, enclosed_holes(o.n_views > 0, cov, o.res, p.handles.shadow_min_thick), cov)
     assert len(hs) == 1 and hs[0].horizontal and hs[0].box == (30, 110, 70, 118)
 
 
@@ -550,8 +556,9 @@ def test_handle_shadows_only_above_eye_level() -> None:
     outline[[0, -1], :] = False
     seen = outline.copy()
     seen[20:28, 10:50] = False
-    assert enclosed_holes(seen, outline, 0.005, row_limit=28).sum() == 8 * 40
-    assert enclosed_holes(seen, outline, 0.005, row_limit=27).sum() == 0
+    thick = HandleConfig().shadow_min_thick
+    assert enclosed_holes(seen, outline, 0.005, thick, row_limit=28).sum() == 8 * 40
+    assert enclosed_holes(seen, outline, 0.005, thick, row_limit=27).sum() == 0
 
 
 def test_shadow_in_cell_picks_the_largest_shadow_centred_in_it() -> None:
@@ -572,11 +579,10 @@ def test_shadow_in_cell_picks_the_largest_shadow_centred_in_it() -> None:
 
 def test_a_cell_with_a_handle_may_be_more_cluttered() -> None:
     """A 0.5 x 0.7 m cell (1 cm px), 25 % of it off its background (a raised panel's shading): over
-    max_clutter 0.18, under max_clutter_handle 0.3. Holding a handle it is a front; without one (cut on
+    clutter.max_share 0.18, under clutter.max_share_handle 0.3. Holding a handle it is a front; without one (cut on
     all four sides, so the handle is the only difference) it is clutter; at 35 % it is clutter either way."""
     from react3d_core.perception.heuristic.front_cells import Cell, Handle
-    from react3d_core.perception.heuristic.fronts import FrontRules
-    from react3d_core.perception.heuristic.image_fronts import ImageFrontParams, _cell_front
+    from react3d_core.perception.heuristic.image_fronts import _cell_front
 
     h, w = 70, 50
     o = _ortho(np.ones((h, w, 3), np.float32), 0.01)
@@ -588,17 +594,16 @@ def test_a_cell_with_a_handle_may_be_more_cluttered() -> None:
     in_plane = np.stack([uu.ravel(), zz.ravel(), np.zeros(uu.size)], 1)
     pix = np.stack(np.meshgrid(np.arange(40, 43), np.arange(20, 40)), -1).reshape(-1, 2)
     handle = Handle((40, 20, 43, 40), False, pix)
-    params = ImageFrontParams()
-    assert params.cells.max_clutter < 0.26 < params.cells.max_clutter_handle
+    cfg = HeuristicConfig()
+    assert cfg.clutter.max_share < 0.26 < cfg.clutter.max_share_handle
     with_handle = Cell(0, 0, w, h, handles=[handle], cut_sides=4)
     without = Cell(0, 0, w, h, handles=[], cut_sides=4)
-    rules = FrontRules()
-    assert _cell_front(o, without, cov, np.zeros((h, w), bool), in_plane, rules, params, None) is not None
-    f = _cell_front(o, with_handle, cov, clutter, in_plane, rules, params, None)
+    assert _cell_front(o, without, cov, np.zeros((h, w), bool), in_plane, cfg, None) is not None
+    f = _cell_front(o, with_handle, cov, clutter, in_plane, cfg, None)
     assert f is not None and f.handle_points is not None and abs(f.w - 0.5) < 0.02 and abs(f.h - 0.7) < 0.02
-    assert _cell_front(o, without, cov, clutter, in_plane, rules, params, None) is None
+    assert _cell_front(o, without, cov, clutter, in_plane, cfg, None) is None
     clutter[:, : int(0.35 * w)] = True                      # 0.34: over both limits
-    assert _cell_front(o, with_handle, cov, clutter, in_plane, rules, params, None) is None
+    assert _cell_front(o, with_handle, cov, clutter, in_plane, cfg, None) is None
 
 
 def _quad(x0: float, x1: float, y0: float, y1: float, z: float) -> TriMesh:
@@ -614,11 +619,11 @@ def test_floor_height_hand_computed() -> None:
 
     floor = _merge(_quad(0, 0.75, 0, 2, -0.002), _quad(0.75, 2, 0, 2, 0.004))
     top = _quad(0, 1, 0, 1, 0.9)
-    assert floor_height(_merge(floor, top), 0.5) == pytest.approx(0.004)
-    assert floor_height(top, 0.5) == pytest.approx(0.9)
-    assert floor_height(top, 2.0) is None
+    assert floor_height(_merge(floor, top), FloorConfig(min_area=0.5)) == pytest.approx(0.004)
+    assert floor_height(top, FloorConfig(min_area=0.5)) == pytest.approx(0.9)
+    assert floor_height(top, FloorConfig(min_area=2.0)) is None
     down = TriMesh(top.vertices, top.faces[:, ::-1])  # facing down: a ceiling, not a floor
-    assert floor_height(down, 0.5) is None
+    assert floor_height(down, FloorConfig(min_area=0.5)) is None
 
 
 def test_handle_less_fronts_reaching_the_floor_are_wall() -> None:
@@ -659,12 +664,12 @@ def test_fit_direction_hand_computed() -> None:
     xy = np.concatenate([wall, door])
     w = np.ones(len(xy))
     nd = np.array([np.cos(np.radians(-88.5)), np.sin(np.radians(-88.5)), 0.0])
-    n, d = fit_direction(xy, w, nd, 3.0)
+    n, d = fit_direction(xy, w, nd, PlanesConfig(refit_deg=3.0))
     assert np.degrees(np.arctan2(n[1], n[0])) == pytest.approx(-89.5, abs=0.051)
     assert n[2] == 0.0 and np.linalg.norm(n) == pytest.approx(1.0)
     assert d == pytest.approx(3.72, abs=0.006)  # the 1 cm window holding the wall
     narrow = _line_points(-89.5, 3.72, 0.0, 0.9)
-    n2, d2 = fit_direction(narrow, np.ones(len(narrow)), nd, 3.0)
+    n2, d2 = fit_direction(narrow, np.ones(len(narrow)), nd, PlanesConfig(refit_deg=3.0))
     assert n2 is nd and d2 == pytest.approx(float(np.mean(narrow @ nd[:2])))
 
 
@@ -677,7 +682,7 @@ def test_fit_direction_keeps_parallel_layers_apart() -> None:
     wall = np.concatenate([_line_points(0.0, 0.0, 0.0, 1.2), _line_points(0.0, 0.0, 2.1, 2.7)])
     leaf = _line_points(0.0, 0.02, 1.2, 2.1)
     xy = np.concatenate([wall, leaf])
-    n, d = fit_direction(xy, np.ones(len(xy)), np.array([1.0, 0.0, 0.0]), 3.0, min_gain=1.0)  # any gain
+    n, d = fit_direction(xy, np.ones(len(xy)), np.array([1.0, 0.0, 0.0]), PlanesConfig(refit_deg=3.0, refit_min_gain=1.0))  # any gain
     assert abs(np.degrees(np.arctan2(n[1], n[0]))) < 0.051
     assert d == pytest.approx(0.0, abs=0.006)
 
@@ -696,7 +701,7 @@ def test_vertical_plane_beside_a_curved_door_is_not_turned() -> None:
     ends = np.array([[0.05, 2.0, 0.5], [2.45, 2.0, 0.5]])
     off = {}
     for r in (0.0, 3.0):
-        p = max(vertical_planes(mesh, cam, min_area=0.2, refit_deg=r), key=lambda q: q.area)
+        p = max(vertical_planes(mesh, cam, PlanesConfig(refit_deg=r), max_tilt=0.3, min_area=0.2), key=lambda q: q.area)
         off[r] = np.abs(ends @ p.n - p.d)
     assert off[3.0].max() < 0.005, off
     assert off[0.0].max() > off[3.0].max(), off
@@ -717,9 +722,9 @@ def test_fit_direction_leaves_separate_short_pieces_alone() -> None:
 
     xy = np.concatenate([_line_points(0.0, 0.0, 0.0, 0.6), _line_points(0.0, 0.01, 1.1, 1.7)])
     nd = np.array([1.0, 0.0, 0.0])
-    n, _ = fit_direction(xy, np.ones(len(xy)), nd, 3.0)
+    n, _ = fit_direction(xy, np.ones(len(xy)), nd, PlanesConfig(refit_deg=3.0))
     assert n is nd
-    n_joined, _ = fit_direction(xy, np.ones(len(xy)), nd, 3.0, min_extent=0.5)  # allowed, it would turn
+    n_joined, _ = fit_direction(xy, np.ones(len(xy)), nd, PlanesConfig(refit_deg=3.0, refit_min_extent=0.5))  # it would turn
     assert abs(np.degrees(np.arctan2(n_joined[1], n_joined[0]))) > 0.2
 
 
@@ -760,12 +765,12 @@ def test_tall_unit_beside_a_base_run_splits_at_its_edge() -> None:
     cov[260:, 100:] = True                           # the run: 0.7 m high
     o = _ortho(img, res)
     o.n_views[~cov] = 0
-    handles = find_handles(o, cov, CellParams())
+    handles = find_handles(o, cov, HeuristicConfig())
     assert len(handles) == 2
-    doors = sorted((c for c in split_cells(o, cov, handles, CellParams()) if c.handles), key=lambda c: c.c0)
+    doors = sorted((c for c in split_cells(o, cov, handles, HeuristicConfig()) if c.handles), key=lambda c: c.c0)
     assert len(doors) == 2
     assert [abs(d.r0 - 260) <= 2 for d in doors] == [True, True]
     assert abs(doors[0].c0 - 100) <= 2 and abs(doors[0].c1 - 200) <= 3 and abs(doors[1].c1 - 300) <= 2
-    off = CellParams(outline_step=0.0)
+    off = HeuristicConfig(cells={"outline_step": 0.0})
     old = sorted((c for c in split_cells(o, cov, handles, off) if c.handles), key=lambda c: c.c0)
     assert any(c.c0 < 90 or c.r0 < 200 for c in old)  # without it a door's cell is not its own

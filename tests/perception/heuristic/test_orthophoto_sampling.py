@@ -10,6 +10,7 @@ import cv2
 import numpy as np
 
 from react3d_core.camera import look_at
+from react3d_core.config.heuristic import CalibrationConfig
 from react3d_core.data.frames import Frame, ImageRef, Intrinsics
 from react3d_core.perception.heuristic.orthophoto import (ColourCalibration, _disagreement, _Points, _remap_points,
                                                           _View, _window_in_view)
@@ -74,8 +75,8 @@ def test_disagreement_is_the_mean_per_pixel_variance_hand_computed() -> None:
     gray = {0: flat, 1: split, 2: flat}
     views = [_Points(i, idx, xn) for i in range(3)]
     # per point the normalised values are {1, 0.5, 1} or {1, 1.5, 1}: variance 1/18 either way
-    assert abs(_disagreement(views, frames, gray, ColourCalibration(), 400) - 1 / 18) < 1e-6
+    assert abs(_disagreement(views, frames, gray, ColourCalibration(), 400, CalibrationConfig()) - 1 / 18) < 1e-6
     # points seen by fewer than 3 views do not count; fewer than 100 such points: no measure
-    assert np.isnan(_disagreement(views[:2], frames, gray, ColourCalibration(), 400))
+    assert np.isnan(_disagreement(views[:2], frames, gray, ColourCalibration(), 400, CalibrationConfig()))
     # a focal scale that throws every point out of the image leaves nothing to compare
-    assert np.isnan(_disagreement(views, frames, gray, ColourCalibration(scale=20.0), 400))
+    assert np.isnan(_disagreement(views, frames, gray, ColourCalibration(scale=20.0), 400, CalibrationConfig()))

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
+from react3d_core.config.heuristic import FloorConfig, FrontRulesConfig, HeuristicConfig, RoomWallConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.geometry import concat_meshes
 from react3d_core.perception.heuristic.fronts import Front
-from react3d_core.perception.heuristic.room_walls import (RoomWallRules, keep_room_doors, on_outer_wall,
-                                                          room_wall_from_config)
+from react3d_core.perception.heuristic.room_walls import keep_room_doors, on_outer_wall
 
 
 def _wall(x0: float, x1: float, y: float, z0: float, z1: float) -> tuple[np.ndarray, np.ndarray]:
@@ -50,9 +49,9 @@ def test_fronts_on_the_outer_wall_are_dropped_unless_shaped_like_a_room_door() -
     painted = _front(3.0, 3.5, 1.0, 1.7, 3.0)
     door = _front(3.8, 4.7, 0.0, 2.0, 3.0)
     door.handle_points = np.array([[4.45, 2.96, 1.0], [4.6, 2.96, 1.0], [4.6, 2.96, 1.02]])
-    rules = RoomWallRules()
+    rules = RoomWallConfig()
     assert on_outer_wall([base, painted, door], mesh, rules) == [False, True, True]
-    kept = keep_room_doors([base, painted, door], mesh, rules, FrontRulesConfig())
+    kept = keep_room_doors([base, painted, door], mesh, rules, FrontRulesConfig(), FloorConfig())
     assert kept == [base, door]
     assert base.kind == "drop"
     assert door.kind == "door"
@@ -68,7 +67,7 @@ def test_behind_share_is_the_area_behind_over_the_whole_scan() -> None:
     patch gives 0.09 / 10.09 = 0.0089 >= 0.005 (not); the patch only 5 cm behind is within ``depth`` (an
     outer wall again)."""
     f = [_front(1.0, 1.5, 1.0, 1.6, 3.0)]
-    rules = RoomWallRules(behind_share=0.005, depth=0.1, min_wall_area=1.0)
+    rules = RoomWallConfig(behind_share=0.005, depth=0.1, min_area=1.0)
     small = _mesh(_wall(0, 4, 3.0, 0, 2.5), _wall(1, 1.2, 3.5, 1, 1.2))
     large = _mesh(_wall(0, 4, 3.0, 0, 2.5), _wall(1, 1.3, 3.5, 1, 1.3))
     near = _mesh(_wall(0, 4, 3.0, 0, 2.5), _wall(1, 1.3, 3.05, 1, 1.3))
@@ -82,11 +81,11 @@ def test_a_lone_cabinet_scanned_from_the_front_is_no_wall() -> None:
     either: every face in the plane belongs to a front): both kept as they were."""
     mesh = _mesh(_wall(0, 0.5, 1.0, 0.1, 0.8), _wall(0.5, 1.0, 1.0, 0.1, 0.8), _floor(-1, 2, -1, 0.9))
     fronts = [_front(0, 0.5, 0.1, 0.8, 1.0, faces=[0, 1]), _front(0.5, 1.0, 0.1, 0.8, 1.0, faces=[2, 3])]
-    assert on_outer_wall(fronts, mesh, RoomWallRules()) == [False, False]
-    assert keep_room_doors(fronts, mesh, RoomWallRules(), FrontRulesConfig()) == fronts
+    assert on_outer_wall(fronts, mesh, RoomWallConfig()) == [False, False]
+    assert keep_room_doors(fronts, mesh, RoomWallConfig(), FrontRulesConfig(), FloorConfig()) == fronts
 
 
 def test_rule_switches_off() -> None:
-    assert room_wall_from_config(HeuristicConfig(room_wall=False)) is None
-    r = room_wall_from_config(HeuristicConfig())
-    assert r is not None and r.behind_share == 0.005 and r.door_w == (0.6, 1.3)
+    assert HeuristicConfig(room_wall={"enabled": False}).room_wall.enabled is False
+    r = HeuristicConfig().room_wall
+    assert r.enabled and r.behind_share == 0.005 and r.door_w == (0.6, 1.3)

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from react3d_core.config.heuristic import SplashbackConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.perception.heuristic.fronts import Front
-from react3d_core.perception.heuristic.splashback import SplashbackRules, on_worktop, splashback_from_config
+from react3d_core.perception.heuristic.splashback import on_worktop
 
 
 def _quad(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> tuple[np.ndarray, np.ndarray]:
@@ -44,7 +45,7 @@ def test_front_on_a_worktop_is_splashback_and_wall_cabinet_or_base_door_is_not()
                  _quad(0.0, 4.0, 0.6, 0.6, 0.0, 2.4))        # the wall
     fronts = [_front(0.2, 1.2, 0.92, 1.40), _front(0.2, 1.2, 1.45, 2.15), _front(0.2, 0.8, 0.1, 0.85),
               _front(2.6, 3.4, 0.92, 1.40)]
-    assert on_worktop(fronts, mesh, SplashbackRules()) == [True, False, False, False]
+    assert on_worktop(fronts, mesh, SplashbackConfig()) == [True, False, False, False]
 
 
 def test_worktop_must_cover_the_strip() -> None:
@@ -52,7 +53,7 @@ def test_worktop_must_cover_the_strip() -> None:
     a 0.2 m deep shelf (2/3 of the strip): dropped. Hand-computed: strip 0.3 m x 1.0 m = 0.3 m²,
     ledge 0.05 x 1.0 = 0.05 m² < 0.2 x 0.3 = 0.06; shelf 0.2 x 1.0 = 0.2 m² >= 0.06."""
     f = [_front(0.0, 1.0, 1.0, 1.5)]
-    rules = SplashbackRules(min_z=0.5, band=0.08, reach=(0.0, 0.3), cover=0.2)
+    rules = SplashbackConfig(min_z=0.5, band=0.08, reach=(0.0, 0.3), cover=0.2)
     ledge = _mesh(_quad(0.0, 1.0, 0.55, 0.6, 1.0, 1.0))
     shelf = _mesh(_quad(0.0, 1.0, 0.4, 0.6, 1.0, 1.0))
     assert on_worktop(f, ledge, rules) == [False]
@@ -63,7 +64,6 @@ def test_rules_from_config_and_switch() -> None:
     from react3d_core.config import PipelineConfig
 
     h = PipelineConfig().perception.heuristic
-    r = splashback_from_config(h)
-    assert r is not None and r.min_z == h.splashback_min_z and r.cover == h.splashback_cover
-    off = PipelineConfig().with_overrides({"perception": {"heuristic": {"splashback": False}}}).perception.heuristic
-    assert splashback_from_config(off) is None
+    assert h.splashback.enabled and (h.splashback.min_z, h.splashback.cover) == (0.5, 0.2)
+    off = PipelineConfig().with_overrides({"perception": {"heuristic": {"splashback": {"enabled": False}}}}).perception.heuristic
+    assert off.splashback.enabled is False

@@ -28,7 +28,7 @@ transformers = pytest.importorskip("transformers")
 torch.set_num_threads(1)
 
 from react3d_core.data.frames import Frame, ImageRef, Intrinsics  # noqa: E402
-from tasks.models.random_checkpoints import save_random_checkpoints  # noqa: E402
+from react3d_models.random_checkpoints import save_random_checkpoints  # noqa: E402
 
 
 def make_frame(frame_id: str, h: int, w: int) -> Frame:

@@ -11,10 +11,9 @@ import torch
 from react3d_core.config import PerceptionConfig
 from react3d_core.perception.interfaces import (ArticulationPredictor, PointPromptSegmenter, Tagger, TagFilter,
                                                 TextPromptSegmenter)
-from tasks.models import STAGE_VERSION, ModelUnavailableError, make_model_perception
-from tasks.models.options import ModelOptions, model_options
-from tasks.models.runtime import cached_keys, resolve_device, resolve_dtype
-from tasks.models.tagger import select_tags
+from react3d_models import STAGE_VERSION, ModelUnavailableError, make_model_perception
+from react3d_models.runtime import cached_keys, resolve_device, resolve_dtype
+from react3d_models.tagger import select_tags
 
 
 def _chat(i, body):
@@ -29,9 +28,10 @@ def _opd(i, body):
 
 def test_full_backend_on_tiny_models(tiny_models, fake_server, make_frame, make_image):
     chat, opd = fake_server(_chat), fake_server(_opd)
-    cfg = PerceptionConfig(backend="models", detector_model=str(tiny_models["detector"]), sam_model=str(tiny_models["sam"]),
-                           tagger_model=str(tiny_models["clip"]), tag_filter_endpoint=chat.url + "/v1",
-                           articulation_endpoint=opd.url, box_threshold=0.0, text_threshold=0.0, batch_size=2, device="cpu")
+    cfg = PerceptionConfig(backend="models", models=dict(
+        detector_model=str(tiny_models["detector"]), sam_model=str(tiny_models["sam"]), tagger_model=str(tiny_models["clip"]),
+        tag_filter_endpoint=chat.url + "/v1", articulation_endpoint=opd.url, box_threshold=0.0, text_threshold=0.0,
+        batch_size=2, device="cpu"))
     p = make_model_perception(cfg)
     assert p.name == "models" and p.version == STAGE_VERSION
     for obj, proto in [(p.tagger, Tagger), (p.tag_filter, TagFilter), (p.segmenter, TextPromptSegmenter),
@@ -48,7 +48,7 @@ def test_full_backend_on_tiny_models(tiny_models, fake_server, make_frame, make_
     assert pm.mask.shape == (48, 64)
     arts = p.articulation.predict(frames, images)
     assert [len(a) for a in arts] == [1, 1, 1] and arts[2][0].frame_id == "f2"
-    assert [len(r["body"]["frames"]) for r in opd.requests] == [2, 1]  # batched by config.batch_size
+    assert [len(r["body"]["frames"]) for r in opd.requests] == [2, 1]  # batched by config.models.batch_size
     # loaded once per worker: a second backend reuses the same model objects
     n = len(cached_keys())
     p2 = make_model_perception(cfg)
@@ -56,12 +56,12 @@ def test_full_backend_on_tiny_models(tiny_models, fake_server, make_frame, make_
 
 
 def test_missing_weights_is_one_clear_line(tmp_path):
-    cfg = PerceptionConfig(backend="models", detector_model=str(tmp_path / "no-gdino"), device="cpu")
+    cfg = PerceptionConfig(backend="models", models=dict(detector_model=str(tmp_path / "no-gdino"), device="cpu"))
     with pytest.raises(ModelUnavailableError) as ei:
         make_model_perception(cfg)
     msg = str(ei.value)
-    assert "\n" not in msg and "Grounding DINO" in msg and "no-gdino" in msg and "perception.detector_model" in msg
-    cfg2 = PerceptionConfig(backend="models", detector_model="IDEA-Research/grounding-dino-tiny-not-cached", device="cpu")
+    assert "\n" not in msg and "Grounding DINO" in msg and "no-gdino" in msg and "perception.models.detector_model" in msg
+    cfg2 = PerceptionConfig(backend="models", models=dict(detector_model="IDEA-Research/grounding-dino-tiny-not-cached", device="cpu"))
     with pytest.raises(ModelUnavailableError, match="HF_HUB_OFFLINE=1.*huggingface-cli download"):
         make_model_perception(cfg2)
 
@@ -72,7 +72,6 @@ def test_device_dtype_and_options():
     assert resolve_dtype("bf16", cpu) == torch.bfloat16
     if not torch.cuda.is_available():
         assert resolve_device("auto") == cpu
-    assert model_options(PerceptionConfig()) == ModelOptions()
 
 
 def test_select_tags_hand_computed():
@@ -155,8 +154,8 @@ def test_local_lm_tag_filter_path(tmp_path):
     unreadable, so only 'door' survives (the documented fallback)."""
     import transformers as tf
 
-    from tasks.models.loaders import load_causal_lm
-    from tasks.models.tag_filter import CachedTagFilter, local_lm_asker
+    from react3d_models.loaders import load_causal_lm
+    from react3d_models.tag_filter import CachedTagFilter, local_lm_asker
 
     words = "[PAD] [UNK] [CLS] [SEP] [MASK] . [ ] , cabinet door drawer table".split()
     torch.manual_seed(0)

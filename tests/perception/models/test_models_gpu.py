@@ -9,18 +9,18 @@ import torch
 
 from react3d_core.config import PerceptionConfig
 from react3d_core.pipeline.steps import split_on_oom
-from tasks.models import make_model_perception
-from tasks.models.grounded_sam import masks_to_original
-from tasks.models.runtime import preprocess
+from react3d_models import make_model_perception
+from react3d_models.grounded_sam import masks_to_original
+from react3d_models.runtime import preprocess
 
 pytestmark = [pytest.mark.gpu, pytest.mark.skipif(not torch.cuda.is_available(), reason="needs a CUDA device")]
 
 
 def _cfg(tiny_models, fake_server) -> PerceptionConfig:
     chat = fake_server(lambda i, body: (200, b'{"choices": [{"message": {"content": "[\\"cabinet\\"]"}}]}', 0))
-    return PerceptionConfig(backend="models", detector_model=str(tiny_models["detector"]), sam_model=str(tiny_models["sam"]),
-                            tagger_model=str(tiny_models["clip"]), tag_filter_endpoint=chat.url + "/v1",
-                            box_threshold=0.0, text_threshold=0.0, batch_size=2, device="cuda")
+    return PerceptionConfig(backend="models", models=dict(
+        detector_model=str(tiny_models["detector"]), sam_model=str(tiny_models["sam"]), tagger_model=str(tiny_models["clip"]),
+        tag_filter_endpoint=chat.url + "/v1", box_threshold=0.0, text_threshold=0.0, batch_size=2, device="cuda"))
 
 
 def test_backend_loads_bf16_on_cuda_and_returns_frame_size_masks(tiny_models, fake_server, make_frame, make_image):

@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 import torch
 
-from tasks.models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, box_nms, detect, detections_from_outputs,
+from react3d_models.grounded_sam import (GroundedSamSegmenter, SamPointSegmenter, box_nms, detect, detections_from_outputs,
                                        detector_prompt, masks_to_original, match_phrase, phrase_groups,
                                        to_sam_input)
-from tasks.models.loaders import load_detector, load_sam
+from react3d_models.loaders import load_detector, load_sam
 
 SIZES = [(48, 64), (96, 128), (60, 80)]
 
@@ -149,7 +149,7 @@ def test_box_nms_hand_computed():
 
 
 def test_top_queries_keeps_the_best_scored_queries_hand_computed():
-    from tasks.models.grounded_sam import top_queries
+    from react3d_models.grounded_sam import top_queries
 
     # 1 image, 4 queries, 2 tokens: best token logits 0.1, 2.0, -1.0, 1.5 -> keep queries 1 and 3, best first
     logits = torch.tensor([[[0.1, -3.0], [2.0, 0.0], [-1.0, -2.0], [-5.0, 1.5]]])
@@ -162,7 +162,7 @@ def test_top_queries_keeps_the_best_scored_queries_hand_computed():
 
 def test_batched_decoder_equals_one_call_per_frame(loaded, make_image):
     """Frames with 1 and 3 boxes decoded together (padded) give the masks of one decoder call per frame."""
-    from tasks.models.grounded_sam import sam_box_masks, sam_box_masks_batched, sam_image_embeddings
+    from react3d_models.grounded_sam import sam_box_masks, sam_box_masks_batched, sam_image_embeddings
 
     _, sam = loaded
     images = [make_image(60, 80, 0), make_image(60, 80, 1)]

@@ -11,9 +11,9 @@ import pytest
 import torch
 from transformers import SamModel
 
-from tasks.models.host_sync import (cache_sam_relative_positions, masks_to_host, pack_bits, skip_shape_checks,
+from react3d_models.host_sync import (cache_sam_relative_positions, masks_to_host, pack_bits, skip_shape_checks,
                                     worker_stream)
-from tasks.models.random_checkpoints import sam_config
+from react3d_models.random_checkpoints import sam_config
 
 
 def _sam() -> SamModel:

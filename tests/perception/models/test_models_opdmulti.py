@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from react3d_core.errors import StageError
-from tasks.models.opdmulti import OPDMultiClient, decode_mask, encode_png
+from react3d_models.opdmulti import OPDMultiClient, decode_mask, encode_png
 
 
 def _png(mask: np.ndarray) -> str:
@@ -98,7 +98,7 @@ def test_prediction_to_world_hand_computed(make_frame):
     origin (0.5, 0, 2) -> R @ o + t = (0, 0.5, 2) + (1, 2, 0.5) = (1, 2.5, 2.5)."""
     from react3d_core.data.frames import Frame
     from react3d_core.data.masks import ArticulationPrediction
-    from tasks.models.opdmulti import prediction_to_world
+    from react3d_models.opdmulti import prediction_to_world
 
     pose = np.array([[0, -1, 0, 1], [1, 0, 0, 2], [0, 0, 1, 0.5], [0, 0, 0, 1]], float)
     f = Frame(**{**make_frame("w", 4, 4).model_dump(), "pose": pose})

@@ -10,7 +10,7 @@ import pytest
 from react3d_core.config import PerceptionConfig
 from react3d_core.scene_io import load_scene
 from react3d_core.scene_io.images import frame_rgb
-from tasks.models import make_model_perception
+from react3d_models import make_model_perception
 
 
 @pytest.mark.slow
@@ -19,9 +19,9 @@ def test_models_backend_on_synthetic_frames(synthetic_scene, tiny_models, fake_s
     frames = list(scene.frames)[:4]
     images = [frame_rgb(f) for f in frames]
     chat = fake_server(lambda i, body: (200, json.dumps({"choices": [{"message": {"content": '["cabinet"]'}}]}).encode(), 0))
-    cfg = PerceptionConfig(backend="models", detector_model=str(tiny_models["detector"]), sam_model=str(tiny_models["sam"]),
-                           tagger_model=str(tiny_models["clip"]), tag_filter_endpoint=chat.url, box_threshold=0.0,
-                           text_threshold=0.0, batch_size=4, device="cpu")
+    cfg = PerceptionConfig(backend="models", models=dict(
+        detector_model=str(tiny_models["detector"]), sam_model=str(tiny_models["sam"]), tagger_model=str(tiny_models["clip"]),
+        tag_filter_endpoint=chat.url, box_threshold=0.0, text_threshold=0.0, batch_size=4, device="cpu"))
     p = make_model_perception(cfg)
     tags = p.tagger.tag(frames, images)
     assert len(tags) == len(frames)

@@ -7,7 +7,7 @@ import json
 import pytest
 
 from react3d_core.errors import StageError
-from tasks.models.tag_filter import CachedTagFilter, chat_asker, chat_url, parse_reply
+from react3d_models.tag_filter import CachedTagFilter, chat_asker, chat_url, parse_reply
 
 TAGS = ["cabinet", "chair", "door", "drawer", "table"]
 

@@ -1,0 +1,303 @@
+"""The check's episodes, written once over :class:`~.sim.Sim`: rest, each joint driven alone, probes.
+
+Drive: every joint has the PD law of ``sim.py`` with ``kp = I w^2``, ``kd = 2 I w`` (critically damped,
+``w = 2 pi drive_hz``, ``I`` the joint's inertia at q = 0), force limit ``max_force``. Joints not being
+driven are held at 0 by the same law. The driven joint's target follows a smoothstep from 0 to its goal
+(the upper limit; the lower one for a joint that only opens below 0) in ``T = clip(|goal| / speed,
+min_move_s, max_move_s)``, holds ``hold_s``, returns to 0 in ``T`` and holds ``hold_s`` again; the target
+velocity is the smoothstep's derivative.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..config.physics import PhysicsConfig
+from .result import JointCheck, Pair, ProbeCheck, RestCheck, Touch
+from .sim import PROBE, Contact, Sim, SimJoint
+from .targets import Front, advance, cavity_box, cavity_probe, fell_enough, front_probe
+
+SPAWN_TOL = 1e-3
+"""A probe placed deeper than this (m) into something was placed inside a collider: the space is not free."""
+
+
+def gains(joints: list[SimJoint], cfg: PhysicsConfig) -> tuple[np.ndarray, np.ndarray]:
+    w = 2 * math.pi * cfg.drive_hz
+    inertia = np.array([max(j.inertia, 1e-4) for j in joints])
+    return inertia * w * w, 2 * inertia * w
+
+
+def smoothstep(x: float) -> tuple[float, float]:
+    """s(x) = 3x^2 - 2x^3 on [0, 1] and its derivative."""
+    x = min(max(x, 0.0), 1.0)
+    return 3 * x * x - 2 * x ** 3, 6 * x * (1 - x)
+
+
+def goal_of(j: SimJoint) -> float:
+    return j.upper if j.upper > 0 else j.lower
+
+
+def move_time(j: SimJoint, cfg: PhysicsConfig) -> float:
+    speed = cfg.revolute_speed if j.joint_type == "revolute" else cfg.prismatic_speed
+    return float(np.clip(abs(goal_of(j)) / speed, cfg.min_move_s, cfg.max_move_s))
+
+
+def target(t: float, goal: float, T: float, hold: float) -> tuple[float, float]:
+    """Position and velocity of the driven joint's target at time ``t`` (module doc)."""
+    if t < T:
+        s, ds = smoothstep(t / T)
+        return goal * s, goal * ds / T
+    if t < T + hold:
+        return goal, 0.0
+    if t < 2 * T + hold:
+        s, ds = smoothstep((t - T - hold) / T)
+        return goal * (1 - s), -goal * ds / T
+    return 0.0, 0.0
+
+
+def speed_limits(joints: list[SimJoint], cfg: PhysicsConfig) -> np.ndarray:
+    return np.array([cfg.max_speed_rad if j.joint_type == "revolute" else cfg.max_speed_m for j in joints])
+
+
+def instability(q: np.ndarray, qd: np.ndarray, vmax: np.ndarray, joints: list[SimJoint], t: float,
+                watch: list[int] | None = None) -> str | None:
+    """'nan' when any joint's state is not finite (the whole simulation is lost), 'blow-up' when a watched
+    joint (default: all) moves faster than its limit; None otherwise."""
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(qd))):
+        return f"nan at {t:.2f} s"
+    idx = list(range(len(joints))) if watch is None else watch
+    ratio = np.abs(qd[idx]) / vmax[idx]
+    if ratio.size and ratio.max() > 1:
+        k = idx[int(np.argmax(ratio))]
+        return f"blow-up at {t:.2f} s ({joints[k].name} at {abs(qd[k]):.1f}/s)"
+    return None
+
+
+@dataclass
+class ContactLog:
+    """Contacts of the watched bodies with any other body: deepest per body, in order of first contact."""
+
+    watch: frozenset[str]
+    order: list[str] = field(default_factory=list)
+    depth: dict[str, float] = field(default_factory=dict)
+    geom: dict[str, str | None] = field(default_factory=dict)
+
+    def add(self, contacts: list[Contact]) -> None:
+        for c in contacts:
+            if c.a in self.watch and c.b not in self.watch:
+                other, g = c.b, c.geom_b
+            elif c.b in self.watch and c.a not in self.watch:
+                other, g = c.a, c.geom_a
+            else:
+                continue
+            d = max(0.0, -c.dist)
+            if other not in self.depth:
+                self.order.append(other)
+                self.depth[other], self.geom[other] = d, g
+            elif d > self.depth[other]:
+                self.depth[other], self.geom[other] = d, g
+
+    @property
+    def deepest(self) -> float:
+        return max(self.depth.values(), default=0.0)
+
+    def touches(self, by_depth: bool = True) -> list[Touch]:
+        names = sorted(self.order, key=lambda n: -self.depth[n]) if by_depth else self.order
+        return [Touch(body=n, depth=self.depth[n], geom=self.geom[n]) for n in names]
+
+
+def _steps(seconds: float, dt: float) -> int:
+    return max(1, int(math.ceil(seconds / dt - 1e-9)))
+
+
+def _every(cfg: PhysicsConfig, dt: float) -> int:
+    return max(1, int(round(1.0 / (cfg.contact_hz * dt))))
+
+
+def rest(sim: Sim, cfg: PhysicsConfig) -> tuple[RestCheck, dict[str, str]]:
+    """Every joint held at 0 for ``rest_s``: contacts after the first step, the largest |q| of each joint.
+    Returns the result and, per joint, a drift or instability found here."""
+    n = len(sim.joints)
+    zeros = np.zeros(n)
+    sim.reset(zeros)
+    vmax = speed_limits(sim.joints, cfg)
+    drift = np.zeros(n)
+    first: list[Contact] = []
+    bad: dict[str, str] = {}
+    for k in range(_steps(cfg.rest_s, sim.dt)):
+        sim.step(zeros, zeros)
+        if k == 0:
+            first = sim.contacts()
+        q, qd = sim.state()
+        t = (k + 1) * sim.dt
+        if instability(q, qd, vmax, sim.joints, t, watch=[]):  # not finite: every joint is lost
+            bad.update({j.name: f"nan at {t:.2f} s while held at 0" for j in sim.joints if j.name not in bad})
+            break
+        for i, j in enumerate(sim.joints):
+            if j.name not in bad and abs(qd[i]) > vmax[i]:
+                bad[j.name] = f"blow-up at {t:.2f} s while held at 0 ({abs(qd[i]):.1f}/s)"
+        drift = np.maximum(drift, np.abs(q))
+    pairs: dict[tuple[str, str], list[float]] = {}
+    for c in first:
+        key = tuple(sorted((c.a, c.b)))
+        pairs.setdefault(key, []).append(max(0.0, -c.dist))  # type: ignore[arg-type]
+    rows = [Pair(a=a, b=b, depth=max(d), points=len(d), moving=a in sim.moving or b in sim.moving) for (a, b), d in pairs.items()]
+    rows.sort(key=lambda p: (-p.depth, p.a, p.b))
+    moving = [p for p in rows if p.moving]
+    tol = np.array([cfg.drift_rad if j.joint_type == "revolute" else cfg.drift_m for j in sim.joints])
+    for j, d, t in zip(sim.joints, drift, tol):
+        if j.name not in bad and d > t:
+            unit = "rad" if j.joint_type == "revolute" else "m"
+            bad[j.name] = f"drift {d:.3f} {unit} while held at 0"
+    out = RestCheck(contacts=len(first), moving_contacts=sum(p.points for p in moving),
+                    deepest=max((p.depth for p in moving), default=0.0),
+                    deepest_static=max((p.depth for p in rows if not p.moving), default=0.0),
+                    pairs=rows[:30], drift={j.name: float(d) for j, d in zip(sim.joints, drift)})
+    return out, bad
+
+
+def drive(sim: Sim, i: int, cfg: PhysicsConfig, object_id: str | None, rest_drift: float,
+          rest_problem: str | None) -> JointCheck:
+    """Joint ``i`` driven alone to its goal and back (module doc); the others held at 0."""
+    j = sim.joints[i]
+    n = len(sim.joints)
+    goal = goal_of(j)
+    base = dict(joint=j.name, link=j.link, object_id=object_id, joint_type=j.joint_type, lower=j.lower, upper=j.upper,
+                rest_drift=rest_drift)
+    if not np.isfinite(goal) or goal == 0:
+        return JointCheck(**base, reached=0.0, returned=0.0, penetration=0.0, passed=False,
+                          causes=["no finite non-zero limit to drive to"])
+    T, hold = move_time(j, cfg), cfg.hold_s
+    vmax = speed_limits(sim.joints, cfg)
+    sim.reset(np.zeros(n))
+    log = ContactLog(frozenset({j.link}))
+    every = _every(cfg, sim.dt)
+    qt, vt = np.zeros(n), np.zeros(n)
+    reached, t_reach, top_speed, unstable = 0.0, None, 0.0, None
+    q = np.zeros(n)
+    for k in range(_steps(2 * T + 2 * hold, sim.dt)):
+        t = (k + 1) * sim.dt
+        qt[i], vt[i] = target(t, goal, T, hold)
+        sim.step(qt, vt)
+        if k % every == 0:
+            log.add(sim.contacts(log.watch))
+        q, qd = sim.state()
+        unstable = instability(q, qd, vmax, sim.joints, t, watch=[i])
+        if unstable:
+            break
+        top_speed = max(top_speed, abs(float(qd[i])))
+        if t <= T + hold + 1e-9:
+            frac = float(q[i] / goal)
+            reached = max(reached, frac)
+            if t_reach is None and frac >= cfg.reach_fraction:
+                t_reach = t
+    returned = float(abs(q[i] / goal)) if not unstable else 1.0
+    unstable = unstable or rest_problem
+    causes = []
+    touched = log.touches()
+    if reached < cfg.reach_fraction:
+        near = ", ".join(f"{t.body} {100 * t.depth:.1f} cm" for t in touched[:3])
+        causes.append(f"reached {reached:.2f} of its limit" + (f" (touching {near})" if near else ""))
+    if log.deepest > cfg.max_penetration_m:
+        worst = touched[0]
+        causes.append(f"penetrates {worst.body} by {100 * worst.depth:.1f} cm" + (f" ({worst.geom})" if worst.geom else ""))
+    if returned > cfg.return_fraction and not unstable:
+        causes.append(f"did not close: {returned:.2f} of its limit left")
+    if unstable:
+        causes.append(unstable)
+    return JointCheck(**base, reached=reached, time_to_reach=t_reach, returned=returned, penetration=log.deepest,
+                      touched=touched, max_speed=top_speed, unstable=unstable, passed=not causes, causes=causes)
+
+
+def _probe_loop(sim: Sim, q_hold: np.ndarray, seconds: float, cfg: PhysicsConfig,
+                track: Callable[[np.ndarray], None] | None = None) -> tuple[ContactLog, float]:
+    """Step with the joints held at ``q_hold``; returns the probe's contacts and how deep it was right
+    after being placed (first step)."""
+    log = ContactLog(frozenset({PROBE}))
+    spawn = 0.0
+    zeros = np.zeros_like(q_hold)
+    for k in range(_steps(seconds, sim.dt)):
+        sim.step(q_hold, zeros)
+        cs = sim.contacts(log.watch)  # every step: a bounce lasts one or two
+        if k == 0:
+            spawn = max((max(0.0, -c.dist) for c in cs), default=0.0)
+        log.add(cs)
+        if track is not None:
+            track(sim.probe()[0])
+    return log, spawn
+
+
+def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
+    """The joint held at its goal; a sphere placed in the cavity falls. Free: placed clear of every collider
+    (<= 1 mm), ends inside the cavity (moved with the joint's final value for a drawer) and came down at
+    least half way to the cavity's bottom. Its deepest penetration is recorded, not judged: on impact a
+    soft contact (MuJoCo's) lets it sink a centimetre into a floor for a few steps."""
+    j = sim.joints[i]
+    goal = goal_of(j)
+    plan = cavity_probe(f, cfg.probe_radius_m)
+    q = np.zeros(len(sim.joints))
+    q[i] = goal
+    sim.reset(q)
+    sim.add_probe(plan.spawn, np.zeros(3), plan.radius, cfg.probe_mass_kg, gravity=True)
+    log, spawn = _probe_loop(sim, q, cfg.cavity_probe_s, cfg)
+    end = sim.probe()[0]
+    q_end = float(sim.state()[0][i])
+    box = plan.box
+    if f.moving_cavity:
+        box = cavity_box(f).moved(f.articulation, q_end)
+    inside = bool(np.all(np.isfinite(end))) and box.contains(end)
+    fell = inside and fell_enough(box, plan.spawn, end, plan.radius)
+    touched = log.touches(by_depth=False)
+    cause = None
+    if spawn > SPAWN_TOL:
+        where = max(log.depth, key=log.depth.get) if log.depth else "?"
+        cause = f"placed inside {where} ({100 * spawn:.1f} cm deep): the cavity is not free space"
+    elif not inside:
+        cause = "pushed out of the cavity" + (f" (touching {', '.join(t.body for t in touched[:3])})" if touched else "")
+    elif not fell:
+        cause = "held up inside the cavity" + (f" by {', '.join(t.body for t in touched[:3])}" if touched else "")
+    return ProbeCheck(kind="cavity", object_id=f.object_id, joint=j.name, radius=plan.radius, start=tuple(plan.spawn),
+                      end=tuple(float(x) for x in end), spawn_depth=spawn, penetration=log.deepest, touched=touched,
+                      passed=cause is None, cause=cause)
+
+
+def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
+    """Every joint held at 0; a sphere (gravity compensated) pushed at the front's centre, for ``front_probe_s``
+    or longer when the front is deep (an unhindered probe ends 5 cm past its back face). Blocked: placed
+    clear of every collider, the first body it touches is the front's link, and its leading point never
+    gets more than ``max_penetration_m`` past the front's back face (into the cavity)."""
+    j = sim.joints[i]
+    plan = front_probe(f, cfg.probe_radius_m, cfg.probe_speed)
+    q = np.zeros(len(sim.joints))
+    sim.reset(q)
+    sim.add_probe(plan.start, plan.velocity, plan.radius, cfg.probe_mass_kg, gravity=False)
+    deepest = [-np.inf]
+
+    def track(p: np.ndarray) -> None:
+        deepest[0] = max(deepest[0], advance(f, p, plan.radius))
+
+    # long enough for an unhindered probe to end 5 cm past the back face, whatever the front's depth
+    seconds = max(cfg.front_probe_s, (float(np.dot(f.back - plan.start, f.n)) + 0.05) / cfg.probe_speed + 0.1)
+    log, spawn = _probe_loop(sim, q, seconds, cfg, track)
+    end = sim.probe()[0]
+    adv = float(deepest[0]) if np.isfinite(deepest[0]) else None  # None: the probe's state was not finite
+    touched = log.touches(by_depth=False)
+    cause = None
+    if spawn > SPAWN_TOL:
+        cause = f"placed inside {max(log.depth, key=log.depth.get)} in front of the front ({100 * spawn:.1f} cm deep)"
+    elif adv is None:
+        cause = "probe state not finite"
+    elif adv > cfg.max_penetration_m:
+        first = f"; first touched {touched[0].body}" if touched else "; touched nothing"
+        cause = f"passed through the front: {100 * adv:.1f} cm past its back face{first}"
+    elif not touched:
+        cause = "touched nothing"
+    elif touched[0].body != j.link:
+        cause = f"hit {touched[0].body} before the front"
+    return ProbeCheck(kind="front", object_id=f.object_id, joint=j.name, radius=plan.radius, start=tuple(plan.start),
+                      end=tuple(float(x) for x in end), spawn_depth=spawn, penetration=log.deepest, advance=adv,
+                      touched=touched, passed=cause is None, cause=cause)

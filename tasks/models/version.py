@@ -1,4 +1,0 @@
-"""Version of the model backend, in a module that imports nothing (so cache keys can name it without
-importing torch, and workers with and without torch agree on heuristic/oracle keys)."""
-
-STAGE_VERSION = "2"  # 2: at most max_detections boxes per frame

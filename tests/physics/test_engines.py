@@ -1,0 +1,148 @@
+"""Real physics in MuJoCo, PyBullet and SAPIEN on the hand-made door + drawer export (tests/physics/scenes.py):
+the clean scene passes; background geometry through the door and in its cavity fails the joint and the
+probe; a door whose front plate is missing lets the front probe through."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from react3d_core.config.physics import ENGINES, PhysicsConfig
+from react3d_core.physics import EngineCheck, PhysicsCheck, check_output
+from react3d_core.physics.check import check_engine
+
+BACKGROUND = {"mujoco": "world", "pybullet": "background", "sapien": "background"}
+"""The static background's body name in each engine (MJCF puts its geoms in the world body)."""
+
+_runs: dict[tuple[str, str], EngineCheck] = {}
+
+
+def run(out: Path, engine: str) -> EngineCheck:
+    pytest.importorskip(engine)
+    key = (str(out), engine)
+    if key not in _runs:
+        _runs[key] = check_output(out, PhysicsConfig(), (engine,)).engines[0]
+    return _runs[key]
+
+
+def by_object(e: EngineCheck) -> dict[str, object]:
+    return {j.object_id: j for j in e.joints}
+
+
+def probes(e: EngineCheck) -> dict[tuple[str, str], object]:
+    return {(p.kind, p.object_id): p for p in e.probes}
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_clean_scene_opens_and_probes_pass(clean_out: Path, engine: str) -> None:
+    e = run(clean_out, engine)
+    assert e.status == "ok", e.reason
+    assert e.rest is not None and e.rest.moving_contacts == 0  # nothing touches at rest
+    joints = by_object(e)
+    assert set(joints) == {"door", "drawer"}
+    for j in joints.values():
+        assert j.passed, (j.joint, j.causes)
+        assert j.reached >= 0.98 and j.returned <= 0.02 and j.penetration <= 0.002 and j.unstable is None
+        assert j.time_to_reach is not None and 0 < j.time_to_reach < 2.5
+    assert len(e.probes) == 4 and all(p.passed for p in e.probes), [(p.kind, p.object_id, p.cause) for p in e.probes]
+    cav = probes(e)
+    # the door's probe lands on the cabinet's bottom board (top at z = 0.04), the drawer's in the drawer
+    # (bottom board top at z = 0.07), both at rest with their centre one radius above it
+    door, drawer = cav[("cavity", "door")], cav[("cavity", "drawer")]
+    assert door.end[2] == pytest.approx(0.04 + door.radius, abs=0.006)
+    assert drawer.end[2] == pytest.approx(0.07 + drawer.radius, abs=0.006)
+    assert drawer.touched[0].body == "drawer"  # it fell into the drawer, not onto the cabinet
+    front = cav[("front", "door")]
+    assert front.touched[0].body == "door" and front.advance is not None and front.advance <= 0.01
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_overlapping_export_fails_and_names_the_cause(overlapping_out: Path, engine: str) -> None:
+    e = run(overlapping_out, engine)
+    assert e.status == "ok", e.reason
+    joints = by_object(e)
+    door = joints["door"]
+    assert not door.passed
+    assert door.touched and door.touched[0].body == BACKGROUND[engine]
+    assert any(BACKGROUND[engine] in c for c in door.causes)
+    assert e.rest is not None and e.rest.moving_contacts > 0 and e.rest.deepest > 0.01
+    assert joints["drawer"].passed, joints["drawer"].causes  # the drawer has nothing in its way
+    cav = probes(e)
+    assert not cav[("cavity", "door")].passed
+    assert cav[("cavity", "drawer")].passed
+    assert not e.passed
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_front_without_collider_lets_the_probe_through(frontless_out: Path, engine: str) -> None:
+    e = run(frontless_out, engine)
+    p = probes(e)[("front", "door")]
+    assert not p.passed and p.cause.startswith("passed through the front")
+    assert p.advance is not None and p.advance > 0.05  # well into the cavity
+    assert probes(e)[("front", "drawer")].passed
+
+
+def test_engines_build_the_same_joints(clean_out: Path) -> None:
+    """Anchor, axis and drive inertia agree across engines (the door: a 0.48 x 0.58 x 0.02 m plate of
+    500 kg/m^3 plus its 4 x 3 x 10 cm handle, hinged at x = -0.99)."""
+    from react3d_core.physics.check import _make
+
+    plate = 0.48 * 0.58 * 0.02 * 500
+    handle = 0.04 * 0.03 * 0.10 * 500
+    inertia = plate * (0.48 ** 2 + 0.02 ** 2) / 12 + plate * (0.24 ** 2 + 0.0 ** 2) \
+        + handle * (0.04 ** 2 + 0.03 ** 2) / 12 + handle * (0.41 ** 2 + 0.025 ** 2)
+    files = {"mujoco": "export/mjcf/scene.xml", "pybullet": "export/urdf/scene.urdf", "sapien": "export/urdf/scene.urdf"}
+    for engine in ENGINES:
+        pytest.importorskip(engine)
+        sim = _make(engine, clean_out / files[engine], PhysicsConfig())
+        try:
+            j = {x.name: x for x in sim.joints}
+            np.testing.assert_allclose(j["door_joint"].anchor, [-0.99, 0.48, 0.32], atol=1e-6)
+            np.testing.assert_allclose(j["door_joint"].axis, [0, 0, -1], atol=1e-6)
+            np.testing.assert_allclose(j["drawer_joint"].axis, [0, -1, 0], atol=1e-6)
+            assert j["door_joint"].inertia == pytest.approx(inertia, rel=0.02), engine
+            assert (j["door_joint"].lower, j["door_joint"].upper) == pytest.approx((0, np.pi / 2))
+            assert "door" in sim.moving and "door_base" not in sim.moving
+        finally:
+            sim.close()
+
+
+def test_mujoco_check_is_deterministic(clean_out: Path) -> None:
+    pytest.importorskip("mujoco")
+    a, b = (check_output(clean_out, PhysicsConfig(), ("mujoco",)) for _ in range(2))
+
+    def strip(c: PhysicsCheck) -> dict:
+        d = c.model_dump(mode="json")
+        d.pop("seconds"), d.pop("created")
+        for e in d["engines"]:
+            e.pop("seconds"), e.pop("cpu_seconds")
+        return d
+
+    assert strip(a) == strip(b)
+
+
+def test_a_missing_engine_is_skipped_with_the_reason(clean_out: Path, monkeypatch) -> None:  # noqa: ANN001
+    import react3d_core.physics.check as chk
+
+    real = chk.find_spec
+    monkeypatch.setattr(chk, "find_spec", lambda name: None if name == "sapien" else real(name))
+    from react3d_core.data import InteractiveScene
+
+    e = check_engine("sapien", clean_out, InteractiveScene.load(clean_out / "scene.json"), PhysicsConfig())
+    assert e.status == "skipped" and "pip install sapien" in (e.reason or "")
+
+
+def test_an_engine_without_its_format_is_skipped(clean_out: Path, tmp_path: Path) -> None:
+    import shutil
+
+    from react3d_core.data import InteractiveScene
+
+    out = tmp_path / "urdf_only"
+    shutil.copytree(clean_out, out)
+    scene = InteractiveScene.load(out / "scene.json")
+    scene.model_copy(update={"exports": {"urdf": scene.exports["urdf"]}}).save(out / "scene.json")
+    check = check_output(out, PhysicsConfig(probes=False), ("mujoco",))
+    assert check.engines[0].status == "skipped" and "MJCF" in check.engines[0].reason
+    assert not check.passed  # nothing ran: nothing was shown to work
