@@ -146,3 +146,21 @@ def test_an_engine_without_its_format_is_skipped(clean_out: Path, tmp_path: Path
     check = check_output(out, PhysicsConfig(probes=False), ("mujoco",))
     assert check.engines[0].status == "skipped" and "MJCF" in check.engines[0].reason
     assert not check.passed  # nothing ran: nothing was shown to work
+
+
+@pytest.mark.parametrize("engine", ENGINES)
+def test_a_front_probe_floats_and_a_cavity_probe_falls(clean_out: Path, engine: str) -> None:
+    # a front probe is gravity compensated (MuJoCo ignores a body's gravcomp set only at run time)
+    pytest.importorskip(engine)
+    from react3d_core.physics.check import _make
+
+    cfg = PhysicsConfig()
+    sim = _make(engine, clean_out / ("export/mjcf/scene.xml" if engine == "mujoco" else "export/urdf/scene.urdf"), cfg)
+    q = np.zeros(len(sim.joints))
+    start = np.array([0.0, -1.0, 1.0])  # in the room, 1 m above the floor, nothing near
+    for gravity, drop in ((False, 0.0), (True, 0.5 * 9.81 * 0.2 ** 2)):
+        sim.reset(q)
+        sim.add_probe(start, np.zeros(3), 0.03, 0.1, gravity=gravity)
+        for _ in range(int(round(0.2 / sim.dt))):
+            sim.step(q, q)
+        assert start[2] - sim.probe()[0][2] == pytest.approx(drop, abs=0.005), (engine, gravity)
