@@ -382,13 +382,16 @@ def box_conflicts(corners: np.ndarray, axes: np.ndarray, obstacles: Sequence[Obs
 
 
 def territory_plane(front_a: np.ndarray, normal_a: np.ndarray, front_b: np.ndarray, normal_b: np.ndarray,
-                    parallel_deg: float = 5.0) -> tuple[np.ndarray, float]:
+                    parallel_deg: float = 5.0, axes: np.ndarray | None = None) -> tuple[np.ndarray, float]:
     """A plane between two neighbouring objects: (m, c) with A's front on the side m . x < c.
 
     Fronts turned against each other (a corner, or two fronts whose estimated normals differ) share
     the bisector of their planes, through the line where the planes meet, when it has each front on
-    its own side; otherwise (coplanar fronts side by side or stacked) the plane lies across the
-    direction from A's front to B's, in the middle of the gap between them."""
+    its own side; otherwise (coplanar fronts side by side or stacked) the plane lies across one
+    direction in the fronts' plane, in the middle of the gap between them along it. ``axes``: candidate
+    directions (the fronts' box axes); the one along which the fronts lie furthest apart is used (a
+    tall door beside a drawer high up: across the row, not along the line between their centres).
+    Without ``axes``, the direction from A's centre (mean point) to B's."""
     na = np.asarray(normal_a, float) / np.linalg.norm(normal_a)
     nb = np.asarray(normal_b, float) / np.linalg.norm(normal_b)
     ca, cb = front_a.mean(0), front_b.mean(0)
@@ -402,6 +405,16 @@ def territory_plane(front_a: np.ndarray, normal_a: np.ndarray, front_b: np.ndarr
             return m, c
     mean_n = na + nb
     mean_n = mean_n / np.linalg.norm(mean_n) if np.linalg.norm(mean_n) > 1e-9 else na
+    if axes is not None:
+        cand = np.asarray(axes, float).reshape(-1, 3)
+        cand = cand - (cand @ mean_n)[:, None] * mean_n  # in the fronts' plane
+        ln = np.linalg.norm(cand, axis=1)
+        cand = cand[ln > 0.5] / ln[ln > 0.5, None]  # axes along the normal drop out
+        if len(cand):
+            cand = cand * np.where(cand @ (cb - ca) < 0, -1.0, 1.0)[:, None]  # from A to B
+            gaps = (front_b @ cand.T).min(0) - (front_a @ cand.T).max(0)
+            m = cand[int(np.argmax(gaps))]
+            return m, float((np.max(front_a @ m) + np.min(front_b @ m)) / 2)
     m = (cb - ca) - ((cb - ca) @ mean_n) * mean_n
     if np.linalg.norm(m) < 1e-9:
         m = cb - ca
@@ -409,17 +422,21 @@ def territory_plane(front_a: np.ndarray, normal_a: np.ndarray, front_b: np.ndarr
     return m, float((np.max(front_a @ m) + np.min(front_b @ m)) / 2)
 
 
-def keep_side(pieces: Sequence[ConvexPiece], m: np.ndarray, c: float) -> tuple[list[ConvexPiece], int]:
+def keep_side(pieces: Sequence[ConvexPiece], m: np.ndarray, c: float, max_loss: float | None = None) -> tuple[list[ConvexPiece], int]:
     """``pieces`` cut to the half-space m . x <= c (a piece left thinner than ``MIN_PIECE_M`` is dropped);
-    returns them and how many were cut or dropped."""
+    returns them and how many were cut or dropped. ``max_loss``: a piece that would lose more than this
+    share of its volume is left whole (for a later, cheaper cut elsewhere)."""
     out, changed = [], 0
     for p in pieces:
         if float((p.vertices @ m).max()) <= c:
             out.append(p)
             continue
-        changed += 1
         pts = clip_halfspace(p.vertices, m, c)
         new = _piece(pts, p.source) if pts is not None else None
+        if max_loss is not None and (0.0 if new is None else new.volume) < (1 - max_loss) * p.volume:
+            out.append(p)
+            continue
+        changed += 1
         if new is not None:
             out.append(new)
     return out, changed

@@ -123,11 +123,19 @@ def _near(a: list[ConvexPiece], b: list[ConvexPiece], margin: float) -> bool:
     return False
 
 
-def split_territories(objects: list[_Object], margin: float) -> int:
+TERRITORY_BOX_MAX_LOSS = 0.9
+"""A drawer-box piece that the territory plane would all but remove (a bottom lying a few mm past it)
+stays whole; one it crosses (a side wall of a box turned towards its neighbour) is cut."""
+
+
+def split_territories(objects: list[_Object], margin: float, box_max_loss: float) -> int:
     """Neighbours whose pieces (front, drawer box, carcass) meet are each cut back to their own side
     of a plane between their fronts (``clearance.territory_plane``), ``margin / 2`` off it: two
     carcasses estimated at an angle, or a drawer box reaching behind its neighbour, then share the
-    disputed space instead of both claiming it. Returns the number of pieces cut."""
+    disputed space instead of both claiming it. A drawer-box piece that would lose more than
+    ``box_max_loss`` of itself stays whole (a drawer's bottom a few mm below the plane, where its
+    neighbour's front overlaps its own): ``clear_paths`` then cuts whichever of the two loses less.
+    Returns the number of pieces cut."""
     cut = 0
     for i, a in enumerate(objects):
         for b in objects[i + 1 :]:
@@ -135,10 +143,11 @@ def split_territories(objects: list[_Object], margin: float) -> int:
                 continue
             fa = np.vstack([p.vertices for p in a.part[: a.n_front]])
             fb = np.vstack([p.vertices for p in b.part[: b.n_front]])
-            m, c = territory_plane(fa, np.asarray(a.obj.front_normal), fb, np.asarray(b.obj.front_normal))
+            m, c = territory_plane(fa, np.asarray(a.obj.front_normal), fb, np.asarray(b.obj.front_normal),
+                                   axes=np.vstack([np.asarray(a.obj.obb.axes, float), np.asarray(b.obj.obb.axes, float)]))
             for o, (mm, cc) in ((a, (m, c - margin / 2)), (b, (-m, -c - margin / 2))):
                 front, k1 = keep_side(o.part[: o.n_front], mm, cc)
-                inner, k2 = keep_side(o.part[o.n_front :], mm, cc)
+                inner, k2 = keep_side(o.part[o.n_front :], mm, cc, max_loss=box_max_loss)
                 o.part, o.n_front = front + inner, len(front)
                 if o.base is not None:
                     o.base, k3 = keep_side(o.base, mm, cc)
@@ -170,7 +179,7 @@ def separate_colliders(objects: list[_Object], config: ExportConfig
     conflicts are left to the joint limits."""
     m = config.collider_clearance_m
     stats = {"parts_cut": 0, "carcass_cut": 0, "pieces_dropped": 0, "part_conflicts_left": 0}
-    stats["territory_cut"] = split_territories(objects, m)
+    stats["territory_cut"] = split_territories(objects, m, TERRITORY_BOX_MAX_LOSS)
     parts, st = separate_at_rest([o.part for o in objects], m)
     stats["parts_cut"] += st.cut
     stats["pieces_dropped"] += st.dropped

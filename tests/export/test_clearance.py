@@ -14,6 +14,7 @@ from react3d_core.export.clearance import (
     face_conflicts,
     gap,
     hull_obstacle,
+    keep_side,
     keep_clear,
     piece_axes,
     separate_at_rest,
@@ -192,3 +193,33 @@ def test_a_box_cut_along_its_own_axis_stays_a_box() -> None:
     ob = hull_obstacle(np.asarray(tilted.vertices) + [1.0, 0.5, 0], "o", "sweep")
     (out,), _ = keep_clear([slab], [ob], 0.005)
     assert out.box is None and gap(out.vertices, piece_axes(out), ob)[0] >= 0.005 - 1e-9
+
+
+def test_territory_plane_lies_across_the_axis_that_separates_the_fronts() -> None:
+    # a tall door (x in [0, 0.5], z in [0, 0.8]) beside a short drawer high up (x in [0.5015, 1], z in [0.6, 0.8]):
+    # the line between their centres is 32 degrees off the row; the plane must be x = 0.50075
+    door = np.array([[x, 0.5, z] for x in (0.0, 0.5) for z in (0.0, 0.8)])
+    drawer = np.array([[x, 0.5, z] for x in (0.5015, 1.0) for z in (0.6, 0.8)])
+    n = np.array([0, 1.0, 0])
+    m, c = territory_plane(door, n, drawer, n)
+    assert abs(m[2]) > 0.3  # without axes: tilted along the centres' line
+    m, c = territory_plane(door, n, drawer, n, axes=np.eye(3))
+    np.testing.assert_allclose(m, [1, 0, 0], atol=1e-12)
+    assert c == pytest.approx(0.50075)
+    # stacked: across z, in the middle of the (negative) gap where the fronts overlap by 2 cm
+    upper = np.array([[x, 0.5, z] for x in (0.0, 0.5) for z in (0.58, 0.8)])
+    lower = np.array([[x + 0.02, 0.5, z] for x in (0.0, 0.5) for z in (0.3, 0.6)])
+    m, c = territory_plane(upper, n, lower, n, axes=np.eye(3))
+    np.testing.assert_allclose(m, [0, 0, -1], atol=1e-12)
+    assert c == pytest.approx(-0.59)
+
+
+def test_keep_side_leaves_a_piece_that_would_lose_too_much() -> None:
+    bottom = cube((0, 0, 0.315), (0.5, 0.5, 0.32))  # a drawer's bottom just under the plane z = 0.321
+    m, c = np.array([0, 0, -1.0]), -0.321  # keep z >= 0.321
+    assert keep_side([bottom], m, c) == ([], 1)  # dropped
+    (kept,), n = keep_side([bottom], m, c, max_loss=0.3)
+    assert kept is bottom and n == 0
+    wall = cube((0, 0, 0.3), (0.5, 0.005, 0.5))  # loses 0.021 / 0.2 = 10.5 %: cut
+    (cut,), n = keep_side([wall], m, c, max_loss=0.3)
+    assert n == 1 and cut.vertices[:, 2].min() == pytest.approx(0.321)
