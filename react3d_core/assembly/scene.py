@@ -1,7 +1,8 @@
 """Scene assembly: dedup -> cavity -> limits -> carving -> meshes + ``scene.json``.
 
 Background vertices inside any part's OBB (grown by ``obb_margin_m``) are deleted with their faces,
-as are the parts' own faces, so a closed part never interpenetrates the background. Output layout
+as are the parts' own faces, so a closed part never interpenetrates the background. Each object is
+labelled and named from the evidence (``naming``: ``drawer_03``, ``door_01``). Output layout
 (docs/CONTRACTS.md section 5)::
 
     scene.json, meshes/background.ply, meshes/<object_id>/{part,base,inner}.ply, vertex_ids.npz
@@ -24,6 +25,7 @@ from ..data.mesh import TriMesh, save_mesh
 from ..data.parts import Articulation, InteractiveObject, InteractiveScene, save_vertex_ids
 from ..dedup import remove_duplicates
 from ..raster import Rasterizer
+from .naming import floor_height, object_ids, part_label, spatial_key
 
 
 class _Geometry:
@@ -121,9 +123,9 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
     bounds = mesh.bounds()
     frames = {f.frame_id: f for f in scene.frames}
     rng = np.random.default_rng(0)
-    objects = []
-    for k, p in enumerate(sorted(parts, key=lambda p: -len(p.vertex_ids))):
-        oid = f"obj_{k:03d}"
+    floor = floor_height(mesh)
+    done = []
+    for p in sorted(parts, key=lambda p: -len(p.vertex_ids)):
         pf = _part_frame(mesh, p)
         frame = frames.get(p.seg_frame_id or "")
         depth = frame_depth(frame) if frame is not None else None
@@ -138,6 +140,11 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
             # closed distances: to everything but the part and its handle (the gaps it glides along)
             art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits, geo.distance_excluding(moving),
                              body_depth=terms["body"])
+        label = part_label(art, pf.center, pf.u, pf.v, pf.su, pf.sv, p.sliding, floor, config.assembly, tag=p.label)
+        done.append((p, pf, art, d_in, src, label))
+    ids = object_ids([d[-1] for d in done], [d[1].center for d in done])
+    objects = []
+    for (p, pf, art, d_in, src, label), oid in sorted(zip(done, ids), key=lambda t: (spatial_key(t[0][1].center), t[1])):
         odir = out / "meshes" / oid
         part_mesh, _ = mesh.submesh(p.face_ids)
         save_mesh(odir / "part.ply", part_mesh)
@@ -148,7 +155,7 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
             inner = f"meshes/{oid}/inner.ply"
         save_vertex_ids(odir / "vertex_ids.npz", p.vertex_ids)
         objects.append(InteractiveObject(
-            object_id=oid, label=p.label, score=p.score, articulation=art, initial_articulation=p.initial, obb=p.obb,
+            object_id=oid, label=label, score=p.score, articulation=art, initial_articulation=p.initial, obb=p.obb,
             front_normal=tuple(pf.n), part_mesh=f"meshes/{oid}/part.ply", base_mesh=f"meshes/{oid}/base.ply",
             inner_mesh=inner, source_vertex_ids=f"meshes/{oid}/vertex_ids.npz", cavity_depth=float(d_in),
             cavity_depth_source=src, top_views=p.top_views, seg_frame_id=p.seg_frame_id))
