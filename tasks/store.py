@@ -64,6 +64,11 @@ def put(obj: Any, kind: str) -> dict[str, str]:
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
+    else:  # reused: its age is its last use, so `cache clean --store` keeps it until its record is written
+        try:
+            os.utime(path)
+        except OSError:
+            pass
     _remember(path)
     storage.push_file(path, relative(path))
     return {"sha256": sha, "path": relative(path), "kind": kind}

@@ -166,3 +166,22 @@ def test_bucket_store_dry_run_lists_exactly_the_unreferenced_then_clean_removes_
     fs.invalidate_cache()
     gone = {B, H, f"{F}/scene.json", f"{F}/m/deep/part.ply", f"{F}.seal.json", f"{G}.seal.json"}
     assert {f[len(root) + 1:] for f in fs.find(root)} == before - gone
+
+
+def test_an_object_reused_by_a_running_task_counts_as_recent(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A task that puts an object the store already holds renews its age: the grace period covers it until
+    the task's record names it, although no record references it yet."""
+    import numpy as np
+
+    from tasks import store, store_clean
+
+    monkeypatch.setenv("REACT3D_STORE", str(tmp_path / "store"))
+    monkeypatch.delenv("PREFECT_LOCAL_STORAGE_PATH", raising=False)
+    (tmp_path / "store" / "prefect-results").mkdir(parents=True)
+    h = store.put({"v": np.arange(3)}, "perception")
+    path = tmp_path / "store" / h["path"]
+    past = time.time() - 7200
+    os.utime(path, (past, past))
+    assert [e.rel for e in store_clean.plan_clean().remove] == [h["path"]]
+    store.put({"v": np.arange(3)}, "perception")
+    assert store_clean.plan_clean().remove == []
