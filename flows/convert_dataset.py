@@ -172,11 +172,11 @@ def fan_out(scenes: list[Path], out_root: str, config: dict[str, Any] | None, de
                     continue
                 del running[fid]
                 if state.is_completed():
-                    manifest = f"{scene_out(out_abs, name)}/scene.json"
                     try:
+                        manifest = storage.output_manifest(scene_out(out_abs, name))  # a remote one: by its pointer
                         rows[name] = _row(name, "ok", started[name], parts=count_parts(manifest), manifest=manifest,
                                           error=_with_history(history[name], ""), **common)
-                    except (OSError, ValueError) as exc:
+                    except (OSError, ValueError, InputError) as exc:
                         rows[name] = _row(name, "failed", started[name], error=f"completed but its manifest is unreadable: {_reason(exc)}", **common)
                 elif state.is_crashed() and attempt < max_attempts:
                     history[name].append(f"attempt {attempt} crashed: {_reason(state.message or state.name or '')}")

@@ -30,9 +30,10 @@ def _roots() -> list:
 
     prefect_home = Path(os.environ.get("PREFECT_HOME", Path.home() / ".prefect"))
     storage = Path(os.environ.get("PREFECT_LOCAL_STORAGE_PATH", prefect_home / "storage"))
-    # collisions/ and reports/: convex decompositions and report pieces cached by content
+    # collisions/ and reports/: convex decompositions and report pieces cached by content; outputs/: verified
+    # local copies of remote outputs that view/export/evaluate read
     return [storage, cache_root() / "objects", cache_root() / "scenes", cache_root() / "quarantine",
-            cache_root() / "collisions", cache_root() / "reports"]
+            cache_root() / "collisions", cache_root() / "reports", cache_root() / "outputs"]
 
 
 def run_store(args: argparse.Namespace) -> int:
@@ -80,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
             continue
         if root.name == "scenes":
             entries = [p for p in root.glob("*/*") if p.is_dir()]
-        elif root.name == "quarantine":  # corrupt objects and folders moved aside, each with its seal
+        elif root.name in ("quarantine", "outputs"):  # corrupt objects moved aside; whole copies of outputs
             entries = list(root.iterdir())
         else:
             entries = [p for p in root.rglob("*") if p.is_file()]

@@ -133,10 +133,12 @@ def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Pat
             for name in SCENES:
                 assert rows[name]["status"] == "ok", rows
                 local = _RESULTS["local"] / name / "scene.json"
-                remote = f"{out}/{name}/scene.json"
+                remote = storage.output_manifest(f"{out}/{name}")  # through its pointer
                 a, b = _normalized_manifest(remote, storage.read_text(remote)), _normalized_manifest(local, local.read_text())
                 assert a == b, f"{name}: manifests differ at {_diff_paths(a, b)[:10]}"
-                fs, path = storage.filesystem(f"{out}/{name}")
+                assert sorted(storage.read_pointer(f"{out}/{name}")["files"]) == sorted(  # names, sizes checked
+                    p.relative_to(local.parent).as_posix() for p in local.parent.rglob("*") if p.is_file())
+                fs, path = storage.filesystem(remote.rsplit("/", 1)[0])
                 remote_files = {p[len(path) + 1:]: hashlib.sha256(fs.cat_file(p)).hexdigest() for p in fs.find(path)}
                 local_files = {p.relative_to(local.parent).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
                                for p in local.parent.rglob("*") if p.is_file()}
