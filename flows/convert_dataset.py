@@ -37,9 +37,34 @@ from .artifacts import create_progress, publish_dataset_table, set_progress  # n
 from .convert_scene import convert_scene  # noqa: E402
 
 
-def find_scenes(root: str | Path, scene_ids: list[str] | None = None, glob: str | None = None) -> list[Path]:
+SCAN_MARKERS = ("scans", "iphone", "dslr", "mesh_aligned_0.05.ply", "transforms.json")
+"""Names whose presence makes a sub-folder of a dataset a scan (without ``--scenes`` / ``--glob``)."""
+
+
+class RemoteScan:
+    """A scan under a remote dataset root (``s3://bucket/scans/<name>``); workers read it through their
+    scan cache (tasks/scan_cache.py). Quacks like the ``Path`` of a local scan where the dataset code needs it."""
+
+    def __init__(self, url: str) -> None:
+        self.url = url.rstrip("/")
+        self.name = self.url.rsplit("/", 1)[-1]
+
+    def resolve(self) -> RemoteScan:
+        return self
+
+    def __str__(self) -> str:
+        return self.url
+
+    def __repr__(self) -> str:
+        return f"RemoteScan({self.url!r})"
+
+
+def find_scenes(root: str | Path, scene_ids: list[str] | None = None, glob: str | None = None) -> list[Any]:
     """Scene folders under ``root``: the named ids, or those matching ``glob`` (default: every folder
-    that looks like a scan: has scans/, iphone/, a mesh or a transforms.json)."""
+    that looks like a scan: has scans/, iphone/, a mesh or a transforms.json). Under a remote ``root``
+    (``s3://...``) the same, as :class:`RemoteScan` prefixes."""
+    if storage.is_remote(root):
+        return _find_remote_scenes(str(root).rstrip("/"), scene_ids, glob)
     root = Path(root)
     if scene_ids:
         return [root / s for s in scene_ids]
@@ -47,23 +72,42 @@ def find_scenes(root: str | Path, scene_ids: list[str] | None = None, glob: str 
     for d in sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith(".")):
         if glob and not fnmatch.fnmatch(d.name, glob):
             continue
-        if glob or any((d / n).exists() for n in ("scans", "iphone", "dslr", "mesh_aligned_0.05.ply", "transforms.json")):
+        if glob or any((d / n).exists() for n in SCAN_MARKERS):
             found.append(d)
     return found
 
 
+def _find_remote_scenes(root: str, scene_ids: list[str] | None, glob: str | None) -> list[RemoteScan]:
+    if scene_ids:
+        return [RemoteScan(f"{root}/{s}") for s in scene_ids]
+    fs, path = storage.filesystem(root)
+    found = []
+    for d in sorted(fs.ls(path, detail=True), key=lambda i: i["name"]):
+        name = d["name"].rstrip("/").rsplit("/", 1)[-1]
+        if d.get("type") != "directory" or name.startswith(".") or (glob and not fnmatch.fnmatch(name, glob)):
+            continue
+        if glob or any(c.rstrip("/").rsplit("/", 1)[-1] in SCAN_MARKERS for c in fs.ls(d["name"], detail=False)):
+            found.append(RemoteScan(f"{root}/{name}"))
+    return found
+
+
 def check_dataset_outputs(root: str | Path, scene_ids: list[str] | None, glob: str | None,
-                          out_root: str | Path) -> list[Path]:
+                          out_root: str | Path) -> list[Any]:
     """Refuse the whole run before any scene starts when one scene's output folder is unsafe to replace
     (see :func:`react3d_core.atomic.check_output_dir`) or a scene id is not a plain folder name
     (``..`` would put a scene's output at the parent of ``out_root``). Returns the scenes."""
     root_p = Path(root)
-    if not root_p.is_dir():
+    remote_root = storage.is_remote(root)
+    if remote_root:
+        fs, path = storage.filesystem(str(root).rstrip("/"))
+        if not fs.isdir(path):
+            raise InputError(root, "dataset prefix not found (or holds nothing)")
+    elif not root_p.is_dir():
         raise InputError(root_p, "dataset folder not found")
     for s in scene_ids or []:
         if s in ("", ".", "..") or "/" in s or "\\" in s:
             raise InputError(root_p / s, "a scene id must be the name of a sub-folder of the dataset folder")
-    scenes = find_scenes(root_p, scene_ids, glob)
+    scenes = find_scenes(root if remote_root else root_p, scene_ids, glob)
     if storage.is_remote(out_root):  # s3://...: each scene's prefix holds nothing react3d did not write
         for scene in scenes:
             storage.check_remote_output(f"{str(out_root).rstrip('/')}/{scene.name}")
@@ -72,7 +116,7 @@ def check_dataset_outputs(root: str | Path, scene_ids: list[str] | None, glob: s
     if out.is_symlink() or (out.exists() and not out.is_dir()):
         raise InputError(out, "exists and is not a folder; choose a new --out folder")
     for scene in scenes:
-        check_output_dir(out / scene.name, (scene, root_p), kind=OUTPUT_KIND)
+        check_output_dir(out / scene.name, () if remote_root else (scene, root_p), kind=OUTPUT_KIND)
     return scenes
 
 
@@ -103,7 +147,7 @@ def _row(scene: str, status: str, t0: float, *, parts: int = 0, manifest: str = 
             "retries": retries, "worker": worker, "error": error, "manifest": manifest, "flow_run": flow_run}
 
 
-def _one(scene: Path, out_root: str, config: dict[str, Any] | None) -> dict[str, Any]:
+def _one(scene: Any, out_root: str, config: dict[str, Any] | None) -> dict[str, Any]:
     t0 = time.perf_counter()
     try:
         manifest = convert_scene.with_options(name=f"convert-{scene.name}")(str(scene), scene_out(out_root, scene.name), config)
@@ -112,7 +156,7 @@ def _one(scene: Path, out_root: str, config: dict[str, Any] | None) -> dict[str,
         return _row(scene.name, "failed", t0, error=_reason(exc), worker="in-process")
 
 
-def fan_out(scenes: list[Path], out_root: str, config: dict[str, Any] | None, deployment: str,
+def fan_out(scenes: list[Any], out_root: str, config: dict[str, Any] | None, deployment: str,
             max_in_flight: int, max_attempts: int, poll_seconds: float = 2.0,
             start_timeout: float | None = None, run_timeout: float | None = None) -> list[dict[str, Any]]:
     """One flow run of ``deployment`` per scene, at most ``max_in_flight`` unfinished at a time; crashed

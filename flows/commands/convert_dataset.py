@@ -10,7 +10,8 @@ HELP = "Convert every scene folder under ROOT (or --scenes / --glob); ends with 
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("root", help="Dataset folder with one sub-folder per scene.")
+    p.add_argument("root", help="Dataset folder with one sub-folder per scene, or its URL (s3://bucket/scans: each "
+                                "worker downloads a scene into its bounded scan cache, REACT3D_SCAN_CACHE_GB).")
     p.add_argument("--out", required=True, help="Output root: one folder per scene.")
     p.add_argument("--scenes", nargs="*", default=None, help="Scene ids (sub-folder names).")
     p.add_argument("--glob", default=None, help="Pattern on sub-folder names, e.g. '0a*'.")

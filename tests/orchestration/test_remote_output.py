@@ -1,5 +1,5 @@
-"""A conversion published to the S3 server (the run's Prefect server, a local store) reads back whole through
-its pointer: the manifest the flow returns is the one the pointer names, and ``export`` / ``view`` work on
+"""A conversion of a scan in a bucket, published to the S3 server (the run's Prefect server, a local store),
+reads back whole through its pointer: the manifest the flow returns is the one the pointer names, and ``export`` / ``view`` work on
 the verified copy. Skipped where s3rver is not installed."""
 
 from __future__ import annotations
@@ -35,8 +35,11 @@ def test_converted_scene_on_s3_reads_back_through_its_pointer(s3: S3Server, synt
     from tasks import storage
 
     scene = synthetic_scene(seed=3, n_frames=16, kind="dresser")
+    scan = s3.url("scans/dresser")  # the scan read from the bucket too, through the scan cache
+    fs, path = storage.filesystem(scan)
+    fs.pipe({f"{path}/{p.relative_to(scene).as_posix()}": p.read_bytes() for p in scene.rglob("*") if p.is_file()})
     url = s3.url("out/dresser")
-    manifest = convert_scene(str(scene), url, CFG)
+    manifest = convert_scene(scan, url, CFG)
     assert manifest == storage.output_manifest(url) and "/v/" in manifest
     copy = storage.fetch_output(url)
     m = InteractiveScene.load(copy / "scene.json")
