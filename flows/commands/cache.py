@@ -31,9 +31,9 @@ def _roots() -> list:
     prefect_home = Path(os.environ.get("PREFECT_HOME", Path.home() / ".prefect"))
     storage = Path(os.environ.get("PREFECT_LOCAL_STORAGE_PATH", prefect_home / "storage"))
     # collisions/ and reports/: convex decompositions and report pieces cached by content; outputs/: verified
-    # local copies of remote outputs that view/export/evaluate read
+    # local copies of remote outputs that view/export/evaluate read; scans/: scans downloaded from a URL
     return [storage, cache_root() / "objects", cache_root() / "scenes", cache_root() / "quarantine",
-            cache_root() / "collisions", cache_root() / "reports", cache_root() / "outputs"]
+            cache_root() / "collisions", cache_root() / "reports", cache_root() / "outputs", cache_root() / "scans"]
 
 
 def run_store(args: argparse.Namespace) -> int:
@@ -81,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
             continue
         if root.name == "scenes":
             entries = [p for p in root.glob("*/*") if p.is_dir()]
-        elif root.name in ("quarantine", "outputs"):  # corrupt objects moved aside; whole copies of outputs
+        elif root.name in ("quarantine", "outputs", "scans"):  # corrupt objects moved aside; whole copies
             entries = list(root.iterdir())
         else:
             entries = [p for p in root.rglob("*") if p.is_file()]
