@@ -80,15 +80,25 @@ def find_scenes(root: str | Path, scene_ids: list[str] | None = None, glob: str 
 def _find_remote_scenes(root: str, scene_ids: list[str] | None, glob: str | None) -> list[RemoteScan]:
     if scene_ids:
         return [RemoteScan(f"{root}/{s}") for s in scene_ids]
+    # one flat listing of every key, not a listing per "folder": S3 servers differ in which common
+    # prefixes they report for a delimiter (s3rver omits those whose keys are two levels deeper)
+    children: dict[str, set[str]] = {}
+    for rel in _remote_keys(root):
+        parts = rel.split("/")
+        if len(parts) >= 2:
+            children.setdefault(parts[0], set()).add(parts[1])
+    return [RemoteScan(f"{root}/{name}") for name, inner in sorted(children.items())
+            if not name.startswith(".") and (fnmatch.fnmatch(name, glob) if glob else bool(inner & set(SCAN_MARKERS)))]
+
+
+def _remote_keys(root: str) -> list[str]:
+    """Every object under the prefix ``root``, relative to it."""
     fs, path = storage.filesystem(root)
-    found = []
-    for d in sorted(fs.ls(path, detail=True), key=lambda i: i["name"]):
-        name = d["name"].rstrip("/").rsplit("/", 1)[-1]
-        if d.get("type") != "directory" or name.startswith(".") or (glob and not fnmatch.fnmatch(name, glob)):
-            continue
-        if glob or any(c.rstrip("/").rsplit("/", 1)[-1] in SCAN_MARKERS for c in fs.ls(d["name"], detail=False)):
-            found.append(RemoteScan(f"{root}/{name}"))
-    return found
+    path = path.rstrip("/")
+    try:
+        return [f[len(path):].lstrip("/") for f in fs.find(path)]
+    except FileNotFoundError:
+        return []
 
 
 def check_dataset_outputs(root: str | Path, scene_ids: list[str] | None, glob: str | None,
@@ -98,11 +108,9 @@ def check_dataset_outputs(root: str | Path, scene_ids: list[str] | None, glob: s
     (``..`` would put a scene's output at the parent of ``out_root``). Returns the scenes."""
     root_p = Path(root)
     remote_root = storage.is_remote(root)
-    if remote_root:
-        fs, path = storage.filesystem(str(root).rstrip("/"))
-        if not fs.isdir(path):
-            raise InputError(root, "dataset prefix not found (or holds nothing)")
-    elif not root_p.is_dir():
+    if remote_root and not _remote_keys(str(root).rstrip("/")):
+        raise InputError(root, "dataset prefix not found (or holds nothing)")
+    if not remote_root and not root_p.is_dir():
         raise InputError(root_p, "dataset folder not found")
     for s in scene_ids or []:
         if s in ("", ".", "..") or "/" in s or "\\" in s:

@@ -134,8 +134,9 @@ def test_a_dataset_in_the_bucket_is_listed_like_a_folder(bucket: str, tmp_path: 
     for name in ("a1", "a2", "b1"):
         _upload(f"{bucket}/scans/{name}", _scan(name))
     _upload(f"{bucket}/scans/zz", {"readme.txt": b"not a scan"})
+    _upload(f"{bucket}/scans/deep", {"scans/mesh_aligned_0.05.ply": b"ply"})  # nothing at its own level
     names = lambda scenes: [s.name for s in scenes]  # noqa: E731
-    assert names(check_dataset_outputs(f"{bucket}/scans", None, None, tmp_path / "out")) == ["a1", "a2", "b1"]
+    assert names(check_dataset_outputs(f"{bucket}/scans", None, None, tmp_path / "out")) == ["a1", "a2", "b1", "deep"]
     assert names(check_dataset_outputs(f"{bucket}/scans", None, "a*", tmp_path / "out")) == ["a1", "a2"]
     assert [str(s) for s in check_dataset_outputs(f"{bucket}/scans", ["b1"], None, tmp_path / "out")] == [f"{bucket}/scans/b1"]
     with pytest.raises(InputError, match="dataset prefix not found"):
