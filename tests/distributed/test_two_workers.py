@@ -92,6 +92,8 @@ def _normalized_manifest(path: str | Path, text: str) -> dict[str, Any]:
     m = json.loads(text)
     m.pop("timings", None)
     m.pop("created", None)
+    if isinstance(m.get("physics"), dict):  # the physics check's record carries its time too
+        m["physics"].pop("created", None)
     mesh = Path(m["input_mesh"])
     # where the scan was read from differs (the dataset folder, a worker's scan cache); the file in it does not
     m["input_mesh"] = "/".join((mesh if mesh.is_absolute() else (Path(path).parent / mesh).resolve()).parts[-2:])
@@ -155,8 +157,8 @@ def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Pat
                 local_files = {p.relative_to(local.parent).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
                                for p in local.parent.rglob("*") if p.is_file()}
                 same = {k for k in local_files if remote_files.get(k) == local_files[k]}
-                # meshes, URDF, metrics: byte-identical; the manifest, report and marker carry times
-                assert set(local_files) - same <= {"scene.json", "report.html", ".react3d-output"}, name
+                # meshes, URDF, metrics: byte-identical; the manifest, report, marker and physics record carry times
+                assert set(local_files) - same <= {"scene.json", "report.html", ".react3d-output", "physics_check.json"}, name
                 assert set(remote_files) == set(local_files), name
         finally:
             for k in s3.env:
