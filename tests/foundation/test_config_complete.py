@@ -307,6 +307,8 @@ DEFAULTS = {
     "perception.heuristic.planes.refit_step_deg": 0.1,
     "perception.heuristic.planes.refit_bin": 0.002,
     "perception.heuristic.planes.refit_sigma": 0.003,
+    "perception.heuristic.planes.max_skew_deg": 5.0,
+    "perception.heuristic.planes.revote_rounds": 1,
     "perception.heuristic.planes.min_area": 0.08,
     "perception.heuristic.planes.cell": 0.04,
     "perception.heuristic.planes.min_fragment_area": 0.03,
