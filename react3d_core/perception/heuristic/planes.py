@@ -95,9 +95,8 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
     # orient each plane's normal towards the cameras that see it
     out = []
     for p in planes:
-        if view_dirs is not None:
-            toward = view_dirs[p.faces].sum(0)
-        else:
+        toward = view_dirs[p.faces].sum(0) if view_dirs is not None else np.zeros(len(p.n))
+        if not np.any(toward):  # no camera saw its faces: towards the cameras' centre
             toward = cam_center - p.to_world(np.mean(p.extent_u), np.mean(p.extent_v))
         if np.dot(p.n, toward) < 0:
             p = _flip(p)

@@ -1,6 +1,7 @@
-"""Planes of pieces of furniture turned in a room: the walls' peak in the direction vote hides a front
-turned by ~11 degrees (on a scan whose normals are noisy), cutting it into slices along the wall's
-direction; those slices are recognised and the faces vote again."""
+"""Planes of pieces of furniture standing free in a room. The walls' peak in the direction vote hides a
+front turned by ~11 degrees (on a scan whose normals are noisy), cutting it into slices along the wall's
+direction: those slices are recognised and the faces vote again. A piece may face away from the room's
+centre: planes turn towards the cameras that saw their faces."""
 
 from __future__ import annotations
 
@@ -106,3 +107,18 @@ def test_is_slice_hand_computed() -> None:
     layers = np.stack([x, np.where(x < 0.12, 0.0, 0.03), np.zeros_like(x)], 1)
     p, th, a, c = _piece(layers, np.full(len(x), 90.0), n)
     assert not is_slice(p, th, a, c, 5.0)      # two layers 3 cm apart, straight normals: no slice
+
+
+def test_planes_face_the_cameras_that_saw_them_not_the_room_centre() -> None:
+    rng = np.random.default_rng(2)
+    v, f = _sheet(0.8, 0.8, 0.02, 0.0, rng)
+    mesh = TriMesh(v + [0.0, 2.0, 0.0], f, np.full((len(v), 3), 150, np.uint8))   # a front at y = 2
+    centre = np.array([0.4, 4.0, 1.4])                                             # the room's centre behind it
+    seen_from = np.tile([0.0, -1.0, 0.0], (mesh.n_faces, 1))                       # cameras at y < 2 saw it
+    (p,) = vertical_planes(mesh, centre, PlanesConfig(), max_tilt=0.25, min_area=0.08)
+    assert p.n @ [0.0, 1.0, 0.0] > 0.99                                            # by the centre: towards +y
+    (p,) = vertical_planes(mesh, centre, PlanesConfig(), max_tilt=0.25, min_area=0.08, view_dirs=seen_from)
+    assert p.n @ [0.0, -1.0, 0.0] > 0.99
+    assert p.n @ p.to_world(0.0, 0.0) == pytest.approx(p.d)
+    (p,) = vertical_planes(mesh, centre, PlanesConfig(), max_tilt=0.25, min_area=0.08, view_dirs=np.zeros_like(seen_from))
+    assert p.n @ [0.0, 1.0, 0.0] > 0.99                                            # unseen: the centre decides
