@@ -292,6 +292,7 @@ class CellConfig(StageConfig):
     min_seen: float = Field(0.55, ge=0, le=1, description="Share of a cell the plane's faces must cover.")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
     handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")
+    stack_min: int = Field(3, ge=0, description="A handle-less cell in a column of at least this many door/drawer-sized cells stacked on one another, each as wide as the next (a drawer pedestal or chest with edge pulls or no handles), is a front; 0: off.")
 
 
 class ClutterConfig(StageConfig):

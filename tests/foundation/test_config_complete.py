@@ -399,6 +399,7 @@ DEFAULTS = {
     "perception.heuristic.cells.min_seen": 0.55,
     "perception.heuristic.cells.min_tile_side": 0.25,
     "perception.heuristic.cells.handleless_min_seams": 2,
+    "perception.heuristic.cells.stack_min": 3,
     "perception.heuristic.clutter.max_share": 0.18,
     "perception.heuristic.clutter.max_share_handle": 0.3,
     "perception.heuristic.clutter.cell_median": True,
