@@ -124,10 +124,18 @@ def cavity_rows(scene_dir: str | Path, out_dir: str | Path, seed: int = 0, confi
     m = assemble_scene(scene, mesh, [p for p, _ in pairs], cfg, out_dir)
     meta = json.loads((Path(scene_dir) / "synth_meta.json").read_text())
     depth_of = {p["label"]: p.get("interior_depth") for p in meta["parts"]}
-    return [{"scene": Path(scene_dir).name, "label": o.label, "type": o.articulation.joint_type,
-             "cavity": o.cavity_depth, "source": o.cavity_depth_source, "true": depth_of.get(o.label),
-             "err": abs(o.cavity_depth - depth_of[o.label]) if depth_of.get(o.label) is not None else None,
+    gt_label = gt_labels(m.objects, [p for p, _ in pairs])
+    return [{"scene": Path(scene_dir).name, "label": gt_label[o.object_id], "type": o.articulation.joint_type,
+             "cavity": o.cavity_depth, "source": o.cavity_depth_source, "true": depth_of.get(gt_label[o.object_id]),
+             "err": abs(o.cavity_depth - depth_of[gt_label[o.object_id]]) if depth_of.get(gt_label[o.object_id]) is not None else None,
              "upper": o.articulation.upper, "limit_source": o.articulation.limit_source} for o in m.objects]
+
+
+def gt_labels(objects: list, parts: list[ArticulatedPart]) -> dict[str, str]:
+    """Object id -> the GT label of the oracle part it was assembled from (assembly names objects by
+    what they are, ``drawer_02``; the part keeps its OBB)."""
+    key = {tuple(np.round(p.obb.center, 6)): p.label for p in parts}
+    return {o.object_id: key[tuple(np.round(o.obb.center, 6))] for o in objects}
 
 
 def summarize(rows: list[dict]) -> dict[str, float | int]:

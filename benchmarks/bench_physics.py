@@ -41,7 +41,7 @@ def convert_config(backend: str, synthetic: bool) -> dict[str, Any]:
 def entries_for(set_name: str, work: Path, backends: list[str], limit: int | None,
                 names: set[str] | None) -> list[dict[str, Any]]:
     """``[{set, backend, name, scene_dir, config}]`` to convert."""
-    from benchmarks.runner import load_spec
+    from flows.bench.runner import load_spec
 
     if set_name == "demo":
         from react3d_core.synthetic import demo_scene
@@ -65,7 +65,7 @@ def entries_for(set_name: str, work: Path, backends: list[str], limit: int | Non
 
 
 def convert(entry: dict[str, Any], work: Path, reuse: bool) -> Path:
-    from benchmarks.runner import run_isolated, run_one
+    from flows.bench.runner import run_isolated, run_one
 
     res = work / "results" / entry["set"] / entry["backend"] / entry["name"]
     if reuse and (res / "scene.json").is_file():
@@ -173,7 +173,7 @@ def main(argv: list[str] | None = None) -> int:
     args = p.parse_args(argv)
 
     from benchmarks._workdir import bench_workdir
-    from benchmarks.runner import run_isolated
+    from flows.bench.runner import run_isolated
     from react3d_core.atomic import write_json
 
     work = bench_workdir(Path(args.work))

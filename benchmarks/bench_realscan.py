@@ -2,6 +2,7 @@
 
     python3 benchmarks/bench_realscan.py [--scene ../shared/data/redkitchen] [--out /tmp/rk_out]
         [--perception heuristic] [--stride N] [--json benchmarks/results/redkitchen_stride5.json]
+    python3 benchmarks/bench_realscan.py --perception-level [--stride N] [--heuristic JSON] --json F
 
 The scan has no 3D ground truth; ``tests/data/redkitchen_fronts.json`` holds 2D boxes of its 9 clearly
 visible fronts in a few colour frames (drawn by hand). ``react3d convert`` runs as its own process (``python -m
@@ -11,6 +12,11 @@ commit), timed end to end (wall) with the peak resident memory of its process tr
 ``react3d_core.metrics.box_labels`` (occlusion-aware projection of every part, Hungarian matching, a
 front is found at mean box IoU >= 0.5). The scan itself is read from outside the repository and never
 copied into it.
+
+``--perception-level`` skips ``react3d convert``: the heuristic perception is built in this process on the
+selected frames and every front it finds is scored as a part (its faces' vertices, its joint). Minutes
+instead of a whole conversion, for deciding thresholds and comparing view sets or mesh variants; report
+acceptance numbers with the full conversion.
 """
 
 from __future__ import annotations
@@ -99,6 +105,53 @@ def manifest_facts(out: Path) -> dict[str, Any]:
     return {"timings": m.get("timings", {}), "frames_config": frames_cfg, "n_objects": len(m.get("objects", []))}
 
 
+def perception_parts(scene_dir: Path, stride: int | None, overrides: dict[str, Any]) -> tuple[list[Any], dict[str, Any]]:
+    """The heuristic's fronts on ``scene_dir`` as scored parts (no conversion): built on the frames the
+    config selects (``stride`` None: the default keyframes), each front's faces' vertices and its joint."""
+    import numpy as np
+
+    from react3d_core.config import PipelineConfig
+    from react3d_core.metrics.box_labels import PredictedPart
+    from react3d_core.perception.heuristic import HeuristicModel
+    from react3d_core.scene_io import load_scene
+
+    cfg = PipelineConfig().with_overrides({"perception": {"heuristic": overrides}, "frames": {"stride": stride}})
+    t0 = time.perf_counter()
+    scene = load_scene(scene_dir, cfg.frames)
+    t1 = time.perf_counter()
+    model = HeuristicModel(scene, cfg.perception.heuristic)
+    t2 = time.perf_counter()
+    parts = []
+    for k, f in enumerate(model.fronts):
+        a = f.articulation
+        v = model.mesh.vertices[np.unique(model.mesh.faces[f.faces].ravel())]
+        parts.append(PredictedPart(f"front_{k:03d}", v, a.joint_type if a is not None else "unknown",
+                                   tuple(float(x) for x in a.axis) if a is not None else None))
+    facts = {"frames_used": len(scene.frames), "load_s": round(t1 - t0, 2), "perception_s": round(t2 - t1, 2),
+             "n_faces": int(model.mesh.n_faces)}
+    if model.image is not None:
+        c = model.image.calibration
+        facts["calibration"] = {"scale": float(c.scale), "dx": float(c.dx), "dy": float(c.dy)}
+    return parts, facts
+
+
+def score_perception_level(scene_dir: Path, labels: Path, stride: int | None, overrides: dict[str, Any],
+                           iou: float = 0.5) -> dict[str, Any]:
+    """``perception_parts`` scored against the box labels (the same matching as a converted scene)."""
+    from react3d_core.metrics.box_labels import load_box_labels, match_boxes, part_boxes
+    from react3d_core.scene_io import load_scene
+
+    parts, facts = perception_parts(scene_dir, stride, overrides)
+    lab = load_box_labels(labels)
+    full = load_scene(scene_dir)  # the labelled frames need not be among those selected
+    report = match_boxes(part_boxes(parts, full, lab), lab, iou)
+    by_id = {p.object_id: p for p in parts}
+    for fr in report.fronts:
+        if fr.part is not None:
+            fr.joint_type, fr.joint_class = by_id[fr.part].joint_type, by_id[fr.part].joint_class
+    return {"perception_level": facts, "evaluation": report.to_dict()}
+
+
 def print_table(report: dict[str, Any]) -> None:
     """Front id, matched part, mean box IoU, joint; then the totals."""
     print(f"{'front':6} {'part':10} {'box IoU':>8} {'other':>6} {'joint':22} found")
@@ -121,11 +174,23 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--note", default="", help="free text stored in the JSON (e.g. which commit an export holds)")
     ap.add_argument("--warm-cache", action="store_true", help="keep the user's task cache (default: an empty one)")
     ap.add_argument("--skip-convert", action="store_true", help="score an existing --out folder only")
+    ap.add_argument("--perception-level", action="store_true",
+                    help="no conversion: score the heuristic's fronts directly (see module docstring)")
+    ap.add_argument("--heuristic", default="{}", help="with --perception-level: JSON overrides of perception.heuristic")
     ap.add_argument("--json", type=Path, default=ROOT / "benchmarks" / "results" / "redkitchen.json")
     args = ap.parse_args(argv)
     if not args.scene.is_dir():
         print(f"scene folder not found: {args.scene}", file=sys.stderr)
         return 2
+    if args.perception_level:
+        res = score_perception_level(args.scene, args.labels, args.stride, json.loads(args.heuristic), args.iou)
+        result = {"scene": str(args.scene), "stride": args.stride, "heuristic": json.loads(args.heuristic),
+                  "note": args.note, "source": _git_state(), **res}
+        print(f"perception level: {res['perception_level']}")
+        print_table(res["evaluation"])
+        _write(args.json, result)
+        print(f"wrote {args.json}")
+        return 0
 
     from react3d_core.metrics.box_labels import evaluate_box_labels
     from react3d_core.scene_io import load_scene

@@ -24,7 +24,7 @@ from react3d_core.atomic import atomic_dir, check_output_dir  # noqa: E402
 from react3d_core.config import PipelineConfig  # noqa: E402
 from react3d_core.pipeline import (OUTPUT_KIND, ProgressFn, StageClock, manifest_versions, output_marker,  # noqa: E402
                                    record_physics)
-from tasks import storage  # noqa: E402
+from tasks import scan_cache, storage  # noqa: E402
 from tasks.articulation import articulate_part  # noqa: E402
 from tasks.assembly import assemble, export, stage_output  # noqa: E402
 from tasks.evaluation import evaluate  # noqa: E402
@@ -59,11 +59,20 @@ def _physics(exported: dict[str, Any], config: dict[str, Any], manifest: str) ->
 @flow(name="react3d-convert-scene", task_runner=ThreadPoolTaskRunner(max_workers=4), persist_result=False)
 def convert_scene(scene_path: str, out_dir: str, config: dict[str, Any] | None = None,
                   progress: ProgressFn | None = None) -> str:
-    """Convert the scan at ``scene_path`` into ``out_dir`` (a folder, or an fsspec URL such as
-    ``s3://bucket/out/scene``); returns the manifest path or URL (``scene.json``).
+    """Convert the scan at ``scene_path`` (a folder, or a URL such as ``s3://bucket/scans/scene``, read
+    through this machine's scan cache: tasks/scan_cache.py) into ``out_dir`` (a folder, or an fsspec URL
+    such as ``s3://bucket/out/scene``); returns the manifest path or URL (``scene.json``).
 
     ``progress(stage, done, total)`` is called as stages advance (the CLI's progress bar); each task is
     handed the whole config and keys and reads only the sections its stages declare."""
+    if storage.is_remote(scene_path):  # the local copy stays in the cache until the conversion ends
+        with scan_cache.local_scene(scene_path) as local:
+            return _convert(str(local), out_dir, config, progress)
+    return _convert(scene_path, out_dir, config, progress)
+
+
+def _convert(scene_path: str, out_dir: str, config: dict[str, Any] | None, progress: ProgressFn | None) -> str:
+    """The body of :func:`convert_scene` for a scan in a local folder."""
     t_all = time.perf_counter()
     remote_out = out_dir if storage.is_remote(out_dir) else None
     if remote_out:  # s3://... : built in a local folder, uploaded once complete (tasks/storage.py)

@@ -22,6 +22,8 @@ import json
 import os
 import shutil
 import tempfile
+import time
+import uuid
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -88,7 +90,9 @@ def remote_root() -> str | None:
 def _fs_cached(protocol_url: str, env_key: str) -> Any:  # noqa: ARG001 - env_key: new credentials, new client
     import fsspec
 
-    return fsspec.core.url_to_fs(protocol_url)[0]
+    # fsspec keeps one instance per constructor arguments, and the endpoint and keys come from the
+    # environment, not the arguments: without skipping its cache a new endpoint would reuse the old client
+    return fsspec.core.url_to_fs(protocol_url, skip_instance_cache=True)[0]
 
 
 def filesystem(url: str) -> tuple[Any, str]:
@@ -233,11 +237,22 @@ def check_remote_output(url: str) -> None:
         raise InputError(url, "holds files that react3d did not write; choose a new --out location")
 
 
+OUTPUT_POINTER = "react3d-output.json"
+"""The pointer object of a published remote output: which prefix holds it, every file's size and sha256."""
+
+VERSIONS_DIR = "v"
+"""Key prefix under a remote output that holds one sub-prefix per publication."""
+
+
 def publish_tree(local: Path, url: str) -> str:
     """Upload a finished local output folder to ``url``; returns the manifest's URL.
 
-    S3 has no atomic rename, so the manifest (``scene.json``) is uploaded last: a reader that sees it
-    sees the whole scene. Files of an earlier react3d output that the new one lacks are removed."""
+    S3 has no atomic rename, so each publication goes under a fresh prefix ``url/v/<id>/`` and the small
+    pointer ``url/react3d-output.json`` (the prefix, every file's size and sha256) is written last: a
+    reader that follows the pointer (:func:`fetch_output`) sees one whole output or refuses it, never half
+    of one. After the pointer lands, publications older than the previous one are removed (a reader that
+    read the previous pointer a moment ago can still finish), and so are files of earlier react3d outputs
+    outside ``v/``."""
     check_remote_output(url)
     url = url.rstrip("/")
     fs, path = filesystem(url)
@@ -245,22 +260,163 @@ def publish_tree(local: Path, url: str) -> str:
     mesh = manifest.get("input_mesh")
     if mesh and not Path(mesh).is_absolute():  # relative to a local folder: meaningless remotely
         manifest["input_mesh"] = str((local / mesh).resolve())
+    manifest_bytes = json.dumps(manifest, indent=2).encode()
+    if not fs.exists(f"{path}/{OUTPUT_MARKER}"):  # first: a half publication is still known to be react3d's
+        fs.pipe_file(f"{path}/{OUTPUT_MARKER}", (local / OUTPUT_MARKER).read_bytes() if (local / OUTPUT_MARKER).is_file() else b"{}")
+    previous = _pointer_prefix(fs, path)
+    vid = f"{time.strftime('%Y%m%dT%H%M%SZ', time.gmtime())}-{uuid.uuid4().hex[:8]}"
+    prefix = f"{VERSIONS_DIR}/{vid}"
+    files = {p.relative_to(local).as_posix(): p for p in sorted(local.rglob("*")) if p.is_file()}
+    entries: dict[str, dict[str, Any]] = {}
+    for rel, p in files.items():
+        if rel != "scene.json":
+            entries[rel] = {"size": p.stat().st_size, "sha256": _file_sha256(p)}
+    entries["scene.json"] = {"size": len(manifest_bytes), "sha256": hashlib.sha256(manifest_bytes).hexdigest()}
+    uploads = [rel for rel in files if rel != "scene.json"]
+    if uploads:  # one batched, concurrent upload
+        fs.put([str(files[r]) for r in uploads], [f"{path}/{prefix}/{r}" for r in uploads])
+    fs.pipe_file(f"{path}/{prefix}/scene.json", manifest_bytes)
+    pointer = {"version": 1, "prefix": prefix, "manifest": "scene.json", "files": entries}
+    fs.pipe_file(f"{path}/{OUTPUT_POINTER}", json.dumps(pointer, indent=1, sort_keys=True).encode())
+    keep = {f"{prefix}/"} | ({f"{previous}/"} if previous else set())
+    stale = [f for f in fs.find(path) if (rel := f[len(path):].lstrip("/")) not in (OUTPUT_MARKER, OUTPUT_POINTER)
+             and not any(rel.startswith(k) for k in keep)]
+    if stale:
+        fs.rm(stale)
+    return f"{url}/{prefix}/scene.json"
+
+
+def _file_sha256(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(1 << 20):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _pointer_prefix(fs: Any, path: str) -> str | None:
+    """The prefix the current pointer names (None: no readable pointer)."""
     try:
-        old = {f[len(path):].lstrip("/") for f in fs.find(path)}
+        return str(json.loads(fs.cat_file(f"{path}/{OUTPUT_POINTER}"))["prefix"]).strip("/")
+    except (FileNotFoundError, ValueError, KeyError, TypeError):
+        return None
+
+
+def read_pointer(url: str) -> dict[str, Any]:
+    """The pointer of the remote output ``url``, checked against what the store lists (names and sizes).
+
+    Raises a one-line :class:`InputError` when it is missing (not a react3d output, or its publication
+    has not finished), unreadable, or does not match the objects under its prefix."""
+    url = url.rstrip("/")
+    fs, path = filesystem(url)
+    try:
+        raw = fs.cat_file(f"{path}/{OUTPUT_POINTER}")
     except FileNotFoundError:
-        old = set()
-    new: set[str] = set()
-    if fs.exists(f"{path}/scene.json"):  # readers must not see the old manifest beside new files
-        fs.rm_file(f"{path}/scene.json")
-    for p in sorted(local.rglob("*")):
-        rel = p.relative_to(local).as_posix()
-        if p.is_file() and rel != "scene.json":
-            fs.put_file(str(p), f"{path}/{rel}")
-            new.add(rel)
-    for rel in sorted(old - new - {"scene.json"}):
-        fs.rm_file(f"{path}/{rel}")
-    fs.pipe_file(f"{path}/scene.json", json.dumps(manifest, indent=2).encode())
-    return f"{url}/scene.json"
+        raise InputError(url, f"has no {OUTPUT_POINTER}: not a published react3d output, or its publication "
+                              "has not finished") from None
+    try:
+        pointer = json.loads(raw)
+        prefix = str(pointer["prefix"]).strip("/")
+        files = {str(k): {"size": int(v["size"]), "sha256": str(v["sha256"])} for k, v in pointer["files"].items()}
+    except (ValueError, KeyError, TypeError, AttributeError):
+        raise InputError(f"{url}/{OUTPUT_POINTER}", "is not a readable react3d output pointer") from None
+    if not prefix.startswith(f"{VERSIONS_DIR}/") or ".." in prefix.split("/") or \
+            any(".." in k.split("/") or k.startswith("/") for k in files) or "scene.json" not in files:
+        raise InputError(f"{url}/{OUTPUT_POINTER}", "names files outside its output; refusing it")
+    try:
+        listed = {f[len(f"{path}/{prefix}"):].lstrip("/"): int(i.get("size", -1))
+                  for f, i in fs.find(f"{path}/{prefix}", detail=True).items() if i.get("type", "file") == "file"}
+    except FileNotFoundError:
+        listed = {}
+    for rel, want in sorted(files.items()):
+        if rel not in listed:
+            raise InputError(f"{url}/{prefix}/{rel}", f"is missing: the output does not match its {OUTPUT_POINTER}")
+        if listed[rel] != want["size"]:
+            raise InputError(f"{url}/{prefix}/{rel}", f"has {listed[rel]} bytes, its {OUTPUT_POINTER} says "
+                                                      f"{want['size']}: the output does not match its pointer")
+    extra = sorted(set(listed) - set(files))
+    if extra:
+        raise InputError(f"{url}/{prefix}/{extra[0]}", f"is not listed in its {OUTPUT_POINTER}: the output does not match its pointer")
+    return {"prefix": prefix, "files": files, "sha": hashlib.sha256(raw).hexdigest()}
+
+
+def output_manifest(out: str) -> str:
+    """The manifest (``scene.json``) of a published output: under a local folder, or the URL its pointer names."""
+    if not is_remote(out):
+        return str(Path(out) / "scene.json")
+    return f"{out.rstrip('/')}/{read_pointer(out)['prefix']}/scene.json"
+
+
+def fetch_output(url: str) -> Path:
+    """A verified local copy of the remote output ``url`` (what ``view``, ``export`` and ``evaluate`` read).
+
+    Follows its pointer (:func:`read_pointer`), downloads every file it lists into this machine's cache
+    (``<cache>/outputs/<pointer sha>/<name>``, appearing by one rename) and checks each file's sha256
+    against it: an output whose objects do not match its pointer is refused with one line, never read."""
+    url = url.rstrip("/")
+    pointer = read_pointer(url)
+    name = url.rsplit("/", 1)[-1] or "output"
+    dest = cache_root() / "outputs" / pointer["sha"][:32] / name
+    if dest.is_dir():
+        return dest
+    fs, path = filesystem(url)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=".tmp", dir=dest.parent))
+    try:
+        rels = sorted(pointer["files"])
+        targets = [tmp / r for r in rels]
+        for t in targets:
+            t.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            fs.get([f"{path}/{pointer['prefix']}/{r}" for r in rels], [str(t) for t in targets])
+        except FileNotFoundError as exc:
+            raise InputError(url, f"an object went away while it was read ({exc}); the output was replaced "
+                                  "or removed meanwhile: run the command again") from None
+        for r, t in zip(rels, targets):
+            if not t.is_file() or _file_sha256(t) != pointer["files"][r]["sha256"]:
+                raise InputError(f"{url}/{pointer['prefix']}/{r}",
+                                 f"does not match the sha256 in its {OUTPUT_POINTER}: refusing the output")
+        try:
+            os.replace(tmp, dest)
+        except OSError:  # another process placed the same copy first
+            if not dest.is_dir():
+                raise
+        return dest
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def fetch_outputs(url: str) -> Path:
+    """A verified local copy of one remote output, or of every output directly under a remote prefix (a
+    dataset's ``--out``), as one local folder with a sub-folder per scene."""
+    url = url.rstrip("/")
+    fs, path = filesystem(url)
+    if fs.exists(f"{path}/{OUTPUT_POINTER}"):
+        return fetch_output(url)
+    try:
+        subs = sorted(d for d in fs.ls(path, detail=False) if fs.exists(f"{d.rstrip('/')}/{OUTPUT_POINTER}"))
+    except FileNotFoundError:
+        subs = []
+    if not subs:
+        raise InputError(url, f"holds no published react3d output (no {OUTPUT_POINTER} there or one level below)")
+    h = hashlib.sha256()
+    copies = {}
+    for d in subs:
+        name = d.rstrip("/").rsplit("/", 1)[-1]
+        copies[name] = fetch_output(f"{url}/{name}")
+        h.update(f"{name}={copies[name]}".encode())
+    root = cache_root() / "outputs" / f"set-{h.hexdigest()[:32]}"
+    if root.is_dir() and not all((root / n).is_dir() for n in copies):  # a copy it links to was pruned
+        shutil.rmtree(root, ignore_errors=True)
+    if not root.is_dir():
+        tmp = Path(tempfile.mkdtemp(prefix=".set.", suffix=".tmp", dir=root.parent))
+        for name, src in copies.items():
+            (tmp / name).symlink_to(src, target_is_directory=True)
+        try:
+            os.replace(tmp, root)
+        except OSError:
+            shutil.rmtree(tmp, ignore_errors=True)
+    return root
 
 
 def read_text(url: str) -> str:

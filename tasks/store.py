@@ -4,7 +4,8 @@ A handle is ``{"sha256": ..., "path": ..., "kind": ...}`` with ``path`` relative
 (``objects/<aa>/<sha256>.npz``), so a cached handle stays valid whatever output folder a later run
 writes to and wherever a worker mounts the store. The store is chosen by ``REACT3D_STORE``
 (tasks/storage.py: a local folder, a shared mount, or ``s3://...`` mirrored in each worker's
-``REACT3D_CACHE``). ``react3d cache clean`` prunes the local folder with Prefect's records.
+``REACT3D_CACHE``). ``react3d cache clean`` prunes the local folder with Prefect's records;
+``react3d cache clean --store`` prunes the store itself by what no record references (tasks/store_clean.py).
 
 Nothing read from the store is trusted blindly: objects are checked against their sha256 on every read,
 store folders (assembly, export) against the seal written beside them; a corrupt one is quarantined
@@ -63,6 +64,11 @@ def put(obj: Any, kind: str) -> dict[str, str]:
         path.parent.mkdir(parents=True, exist_ok=True)
         with atomic_path(path) as tmp:
             tmp.write_bytes(data)
+    else:  # reused: its age is its last use, so `cache clean --store` keeps it until its record is written
+        try:
+            os.utime(path)
+        except OSError:
+            pass
     _remember(path)
     storage.push_file(path, relative(path))
     return {"sha256": sha, "path": relative(path), "kind": kind}

@@ -13,6 +13,7 @@ import multiprocessing as mp
 import os
 import resource
 import shutil
+import tempfile
 import time
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager, nullcontext
@@ -38,9 +39,10 @@ def load_spec(spec: str, out_dir: Path, frames: int | None = None) -> list[dict[
             for e in d["scenes"]:
                 src, seed, kind = e.get("source", "procedural"), int(e["seed"]), e.get("kind")
                 # scan realism (generate_scene's mesh / realism / misregister) is part of the scene's name
-                opts = {k: e[k] for k in ("mesh", "realism", "misregister", "depth_dropout") if k in e}
+                opts = {k: e[k] for k in ("mesh", "realism", "misregister", "depth_dropout", "decimate") if k in e}
                 name = "_".join([f"{src}_{kind or 'any'}_{seed}"] + [str(opts[k]) for k in ("mesh", "realism") if k in opts]
-                                + ([f"dropout-{opts['depth_dropout']}"] if opts.get("depth_dropout", "none") != "none" else []))
+                                + ([f"dropout-{opts['depth_dropout']}"] if opts.get("depth_dropout", "none") != "none" else [])
+                                + ([f"d{float(opts['decimate']):g}"] if "decimate" in opts else []))
                 out.append({"name": name, "source": src, "kind": kind, "seed": seed, "n_frames": int(e.get("n_frames", n)),
                             "scene_dir": str(out_dir / "scenes" / f"{name}_f{int(e.get('n_frames', n))}"), "synth": opts})
             return out
@@ -57,16 +59,17 @@ def _peak_rss_mb() -> float:
 
 
 @contextmanager
-def cold_cache(root: str | Path) -> Iterator[Path]:
-    """Run inside an empty object store and Prefect result storage under ``root`` (deleted afterwards).
+def cold_cache(parent: str | Path) -> Iterator[Path]:
+    """Run inside an empty object store and Prefect result storage made fresh under ``parent``.
 
     Content keys make a second run of the same scene a cache hit: timings of a benchmark that follows a
-    check run would otherwise be those of a re-run.
+    check run would otherwise be those of a re-run. The folder is a new one this run made (a unique
+    name), so removing it afterwards can never remove anything else that lives under ``parent``.
     """
     from prefect.settings import PREFECT_LOCAL_STORAGE_PATH, temporary_settings
 
-    root = Path(root)
-    shutil.rmtree(root, ignore_errors=True)
+    Path(parent).mkdir(parents=True, exist_ok=True)
+    root = Path(tempfile.mkdtemp(prefix=".cold-cache-", dir=parent))
     old = os.environ.get("REACT3D_CACHE")
     os.environ["REACT3D_CACHE"] = str(root / "react3d")
     try:
@@ -148,7 +151,7 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
               miss_causes: bool = False) -> dict[str, Any]:
     """Convert and evaluate every entry; failed scenes are reported in ``failed`` and skipped.
 
-    ``cold``: each scene converts with an empty cache (under ``out_dir/cold-cache``, removed after).
+    ``cold``: each scene converts with an empty cache (a fresh ``out_dir/.cold-cache-*``, removed after).
     ``miss_causes``: each scene gets ``miss_causes`` (counts per cause and one row per traced GT part)
     and the result a pooled ``miss_causes`` (every cause key present; docs/evaluation.md)."""
     from react3d_core.config.metrics import EvaluationConfig
@@ -163,7 +166,7 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
         try:
             if "source" not in e and not Path(e["scene_dir"]).is_dir():
                 raise InputError(e["scene_dir"], "scene folder not found")
-            r = run_isolated(run_one, e, str(res_dir), config, str(out_dir / "cold-cache") if cold else None, miss_causes)
+            r = run_isolated(run_one, e, str(res_dir), config, str(out_dir) if cold else None, miss_causes)
             pred = InteractiveScene.load(r["manifest"])
             gt_dir = _gt_dir(Path(e["scene_dir"]))
             if gt_dir is None:

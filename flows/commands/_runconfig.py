@@ -61,8 +61,9 @@ def pipeline_overrides(args: argparse.Namespace) -> dict[str, Any]:
     if args.formats:
         formats = [f.strip().lower() for f in args.formats.split(",") if f.strip() and f.strip().lower() != "none"]
         put(("export", "formats"), formats)
-    if args.physics:
-        engines = [e.strip().lower() for e in args.physics.split(",") if e.strip()]
+    physics = getattr(args, "physics", None)  # commands without the flag keep the configured check
+    if physics:
+        engines = [e.strip().lower() for e in physics.split(",") if e.strip()]
         if engines == ["none"]:
             put(("physics", "enabled"), False)
         else:

@@ -10,7 +10,8 @@ HELP = "Convert every scene folder under ROOT (or --scenes / --glob); ends with 
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("root", help="Dataset folder with one sub-folder per scene.")
+    p.add_argument("root", help="Dataset folder with one sub-folder per scene, or its URL (s3://bucket/scans: each "
+                                "worker downloads a scene into its bounded scan cache, REACT3D_SCAN_CACHE_GB).")
     p.add_argument("--out", required=True, help="Output root: one folder per scene.")
     p.add_argument("--scenes", nargs="*", default=None, help="Scene ids (sub-folder names).")
     p.add_argument("--glob", default=None, help="Pattern on sub-folder names, e.g. '0a*'.")
@@ -19,8 +20,25 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
                    help="Fan scenes out to the workers of a deployment, e.g. react3d-convert-scene/convert-scene "
                         "(needs PREFECT_API_URL of a server; docs/orchestration.md). Default: in this process.")
     p.add_argument("--max-attempts", type=int, default=3,
-                   help="With --deployment: runs per scene when a run crashes (worker died); failed scenes are not retried.")
+                   help="With --deployment: runs per scene when a run crashes (worker died) or times out; failed scenes are not retried.")
+    p.add_argument("--start-timeout", type=_seconds, default=None, metavar="S",
+                   help="With --deployment: cancel a scene's run that no worker has started within S seconds, "
+                        "and submit it again while attempts remain (default: wait for ever).")
+    p.add_argument("--run-timeout", type=_seconds, default=None, metavar="S",
+                   help="With --deployment: cancel a scene's run not finished S seconds after it started, "
+                        "and submit it again while attempts remain (default: no limit).")
     add_pipeline_arguments(p)
+
+
+def _seconds(text: str) -> float:
+    """A positive number of seconds (argparse type)."""
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number of seconds: {text!r}") from None
+    if not v > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0 seconds: {text!r}")
+    return v
 
 
 def run(args: argparse.Namespace) -> int:
@@ -38,6 +56,10 @@ def run(args: argparse.Namespace) -> int:
 
     from flows.convert_dataset import check_dataset_outputs
 
+    if (args.start_timeout or args.run_timeout) and not args.deployment:
+        from react3d_core.errors import InputError
+
+        raise InputError(None, "--start-timeout and --run-timeout apply to runs on workers: add --deployment")
     cfg = pipeline_overrides(args)
     check_dataset_outputs(args.root, args.scenes, args.glob, args.out)  # before any scene runs
     from flows import local_server
@@ -53,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     with console.status("converting scenes (per-scene progress in the Prefect UI when a server is configured)"), \
             prefect_errors_to_log(log_path()):
         rows = convert_dataset(args.root, args.scenes, args.glob, args.out, cfg, args.concurrency,
-                               args.deployment, args.max_attempts)
+                               args.deployment, args.max_attempts, args.start_timeout, args.run_timeout)
     t = Table(title=f"{sum(r['status'] == 'ok' for r in rows)}/{len(rows)} scenes converted")
     cols = ("scene", "status", "parts", "seconds", "retries", "worker", "error") if args.deployment else \
         ("scene", "status", "parts", "seconds", "error")

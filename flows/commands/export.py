@@ -14,6 +14,29 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--config", default=None, help="Pipeline config JSON; its 'export' section is used.")
     p.add_argument("--ros-package", action="store_true", help="Also write a ROS 2 description package (package:// paths).")
     p.add_argument("--texel-per-m", type=float, default=None, help="Texture budget override (texels per metre).")
+    p.add_argument("--to", default=None, help="For an s3://... OUT: a new local folder that receives the output "
+                                              "(read through its pointer, checked against it) and the export.")
+
+
+def _local_copy(url: str, to: str | None) -> object:
+    """The verified remote output ``url`` copied into the new local folder ``to`` (exports write there)."""
+    import shutil
+    from pathlib import Path
+
+    from react3d_core.errors import InputError
+    from tasks import storage
+
+    if not to:
+        raise InputError(url, "is a remote output: add --to DIR, a new local folder to export into")
+    dest = Path(to)
+    if dest.exists():
+        raise InputError(dest, "exists; --to must name a new folder")
+    src = storage.fetch_output(url.removesuffix("/scene.json"))
+    tmp = dest.with_name(f".{dest.name}.tmp")
+    shutil.rmtree(tmp, ignore_errors=True)
+    shutil.copytree(src, tmp)
+    tmp.rename(dest)
+    return dest
 
 
 def run(args: argparse.Namespace) -> int:
@@ -26,6 +49,12 @@ def run(args: argparse.Namespace) -> int:
     from react3d_core.atomic import is_react3d_output
     from react3d_core.errors import InputError
 
+    from tasks import storage
+
+    if storage.is_remote(args.out):
+        args.out = str(_local_copy(args.out, args.to))
+    elif args.to:
+        raise InputError(args.to, "--to is for an s3://... output; a local OUT is exported in place")
     folder = Path(args.out)
     folder = folder.parent if folder.name == "scene.json" and not folder.is_dir() else folder
     if not is_react3d_output(folder, "scene"):

@@ -17,6 +17,7 @@ from ..data.mesh import TriMesh
 from ..data.parts import OBB, Articulation, PartCandidate
 from .obb import min_obb
 from .refine import is_flat, refine_prismatic, refine_revolute, refine_sliding, slab_mid_and_thickness
+from .sliding import sliding_agrees
 from .types import ArticulatedPart
 from .upright import upright_box
 from .validate import best_prediction, consensus_joint, lift_prediction, matching_predictions, view_matches
@@ -102,7 +103,8 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
     cam = next((f.c2w[:3, 3] for f in scene.frames if f.frame_id == seg_id), frame.c2w[:3, 3])
     fit = fit_part(pts, cam, candidate.plane_normal, config.articulation.flat_ratio, config.articulation.upright_tolerance)
     obb, n, thickness, flat = fit.obb, fit.front_normal, fit.thickness, fit.flat
-    sliding = bool(pred.sliding and pred.joint_type == "prismatic")
+    sliding = bool(pred.sliding and pred.joint_type == "prismatic") and sliding_agrees(
+        initial.axis, obb, n, candidate.label, config.articulation.sliding_min_height_m)
     art = refine_articulation(initial, fit, config.articulation.refine, sliding)
     return ArticulatedPart(
         candidate_id=candidate.candidate_id, label=candidate.label, score=float(candidate.score * pred.score),

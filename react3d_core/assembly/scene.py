@@ -1,7 +1,8 @@
 """Scene assembly: dedup -> cavity -> limits -> carving -> meshes + ``scene.json``.
 
 Background vertices inside any part's OBB (grown by ``obb_margin_m``) are deleted with their faces,
-as are the parts' own faces, so a closed part never interpenetrates the background. Output layout
+as are the parts' own faces, so a closed part never interpenetrates the background. Each object is
+labelled and named from the evidence (``naming``: ``drawer_03``, ``door_01``). Output layout
 (docs/CONTRACTS.md section 5)::
 
     scene.json, meshes/background.ply, meshes/<object_id>/{part,base,inner}.ply, vertex_ids.npz
@@ -14,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..articulation.limits import set_limits
+from ..articulation.limits import set_limits, sweep_points
 from ..articulation.refine import slab_mid_and_thickness
 from ..articulation.types import ArticulatedPart
 from ..cavity import PartFrame, base_mesh, estimate_cavity, inner_box_mesh
@@ -24,6 +25,7 @@ from ..data.mesh import TriMesh, save_mesh
 from ..data.parts import Articulation, InteractiveObject, InteractiveScene, save_vertex_ids
 from ..dedup import remove_duplicates
 from ..raster import Rasterizer
+from .naming import floor_height, object_ids, part_label, spatial_key
 
 
 class _Geometry:
@@ -68,6 +70,20 @@ def attached_faces(mesh: TriMesh, p: ArticulatedPart, pf: PartFrame, reach: floa
     return own
 
 
+def moving_faces(mesh: TriMesh, own: np.ndarray, p: ArticulatedPart, pf: PartFrame, inset: float = 0.01) -> np.ndarray:
+    """The part's faces and, of the other attached faces (``own``), those wholly inside its outline less
+    ``inset``: a handle the segmentation left out moves with the part and sweeps with it; the floor or a
+    worktop that merely reaches into the outline's edge does not."""
+    extra = own.copy()
+    extra[p.face_ids] = False
+    v = mesh.vertices[mesh.faces[extra]] - pf.center
+    inside = ((np.abs(v @ pf.u) <= pf.su / 2 - inset) & (np.abs(v @ pf.v) <= pf.sv / 2 - inset)).all(1)
+    out = np.zeros(mesh.n_faces, bool)
+    out[p.face_ids] = True
+    out[np.flatnonzero(extra)[inside]] = True
+    return out
+
+
 def carve_background(mesh: TriMesh, parts: list[ArticulatedPart], margin: float) -> np.ndarray:
     """Face ids of the background: faces of no part, with no vertex inside a (grown) part OBB."""
     inside = np.zeros(mesh.n_vertices, bool)
@@ -107,24 +123,28 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
     bounds = mesh.bounds()
     frames = {f.frame_id: f for f in scene.frames}
     rng = np.random.default_rng(0)
-    objects = []
-    for k, p in enumerate(sorted(parts, key=lambda p: -len(p.vertex_ids))):
-        oid = f"obj_{k:03d}"
+    floor = floor_height(mesh)
+    done = []
+    for p in sorted(parts, key=lambda p: -len(p.vertex_ids)):
         pf = _part_frame(mesh, p)
         frame = frames.get(p.seg_frame_id or "")
         depth = frame_depth(frame) if frame is not None else None
-        d_in, src, _ = estimate_cavity(pf, geo.cast, bounds, frame, depth, config.cavity)
-        pts = mesh.vertices[p.vertex_ids]
-        if len(pts) > 600:
-            pts = pts[rng.choice(len(pts), 600, replace=False)]
+        d_in, src, terms = estimate_cavity(pf, geo.cast, bounds, frame, depth, config.cavity)
         own = attached_faces(mesh, p, pf)
+        moving = moving_faces(mesh, own, p, pf)
+        pts = sweep_points(mesh.vertices[np.union1d(p.vertex_ids, mesh.faces[moving].ravel())], 600, rng)
         dist = geo.distance_excluding(own, pf.center - pf.n * pf.thickness / 2, pf.n, with_points=True)
-        own_faces = np.zeros(mesh.n_faces, bool)
-        own_faces[p.face_ids] = True  # closed distances: everything but the part itself (gaps it glides along)
         if p.sliding:
             art = sliding_limits(p.articulation, pts, config.limits.prismatic_margin_m, config.limits.prismatic_min_m)
         else:
-            art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits, geo.distance_excluding(own_faces))
+            # closed distances: to everything but the part and its handle (the gaps it glides along)
+            art = set_limits(p.articulation, pts, pf.n, d_in, dist, config.limits, geo.distance_excluding(moving),
+                             body_depth=terms["body"])
+        label = part_label(art, pf.center, pf.u, pf.v, pf.su, pf.sv, p.sliding, floor, config.assembly, tag=p.label)
+        done.append((p, pf, art, d_in, src, label))
+    ids = object_ids([d[-1] for d in done], [d[1].center for d in done])
+    objects = []
+    for (p, pf, art, d_in, src, label), oid in sorted(zip(done, ids), key=lambda t: (spatial_key(t[0][1].center), t[1])):
         odir = out / "meshes" / oid
         part_mesh, _ = mesh.submesh(p.face_ids)
         save_mesh(odir / "part.ply", part_mesh)
@@ -135,7 +155,7 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
             inner = f"meshes/{oid}/inner.ply"
         save_vertex_ids(odir / "vertex_ids.npz", p.vertex_ids)
         objects.append(InteractiveObject(
-            object_id=oid, label=p.label, score=p.score, articulation=art, initial_articulation=p.initial, obb=p.obb,
+            object_id=oid, label=label, score=p.score, articulation=art, initial_articulation=p.initial, obb=p.obb,
             front_normal=tuple(pf.n), part_mesh=f"meshes/{oid}/part.ply", base_mesh=f"meshes/{oid}/base.ply",
             inner_mesh=inner, source_vertex_ids=f"meshes/{oid}/vertex_ids.npz", cavity_depth=float(d_in),
             cavity_depth_source=src, top_views=p.top_views, seg_frame_id=p.seg_frame_id))

@@ -11,7 +11,8 @@
   no camera saw: d_hit then reaches the room wall 2 m away and a drawer got 1.18 m of travel in a
   0.37 m chest; a wall cabinet whose wall no camera saw behind it). Rays cast straight up
   from points ever deeper behind the front hit the carcass top or worktop at about the same distance
-  while they are inside the furniture (down to a wall cabinet's bottom board when nothing is above);
+  while they are inside the furniture (down to a wall cabinet's bottom board when nothing is above;
+  sideways to its own side panels when neither profile ends, a tall unit whose top no camera saw);
   the first depth where the hit jumps by ``body_jump_m`` (or vanishes) is past its back.
 Depths are measured from the slab's back face.
 """
@@ -89,44 +90,71 @@ def d_image(pf: PartFrame, frame: Frame | None, depth: np.ndarray | None, cfg: C
     return float(behind.max())
 
 
-def d_body(pf: PartFrame, cast: callable, cfg: CavityConfig, up: np.ndarray = UP) -> float:  # type: ignore[valid-type]
+def _profile_end(pf: PartFrame, cast: callable, cs: np.ndarray, spread: np.ndarray, axis: np.ndarray,  # type: ignore[valid-type]
+                 d: np.ndarray, cfg: CavityConfig) -> tuple[float, float]:
+    """(reference hit distance, depth where the body ends) of the rays along ``d`` from points at depths
+    ``cs`` behind the back face, spread by ``spread`` along ``axis`` (median per depth). The reference is
+    the median of the first three depths (inf: nothing there); the body ends half a step before the first
+    depth whose hit is ``body_jump_m`` farther or missing (inf: no such depth)."""
+    origins = (pf.back + cs[:, None, None] * pf.n + spread[None, :, None] * axis).reshape(-1, 3)
+    t = np.asarray(cast(origins, np.tile(d, (len(origins), 1))), float).reshape(len(cs), len(spread))
+    t = np.median(np.where(np.isfinite(t), t, np.inf), axis=1)
+    t0 = float(np.median(t[:3]))
+    if not np.isfinite(t0):
+        return np.inf, np.inf
+    out = np.flatnonzero(~(t <= t0 + cfg.body_jump_m))
+    out = out[out >= 3]
+    return t0, (float(cs[out[0]] - 0.5 * cfg.body_step_m) if len(out) else np.inf)
+
+
+def d_body(pf: PartFrame, cast: callable, cfg: CavityConfig, up: np.ndarray = UP,  # type: ignore[valid-type]
+           floor: float = -np.inf) -> float:
     """Depth behind the back face at which the furniture around the part ends (inf if not found).
 
-    Rays straight up from 3 points across the part's width, at depths ``body_step_m`` apart; the
-    reference is the median hit distance of the first three depths (inside the carcass: its top or the
-    worktop); the body ends half a step before the first depth whose median hit is ``body_jump_m``
-    farther or missing. Only when nothing at all is above the part (a wall cabinet whose top no camera
-    saw) are rays cast down instead, to its bottom board: below a base unit they would follow plinths
-    and toe-kicks (on a scene-synthesizer kitchen they cut two 0.69 m base cavities to 0.19 m). Fronts
-    facing up or down (flaps in a worktop) have no such profile."""
+    Rays straight up from 3 points across the part's width, at depths ``body_step_m`` apart, hit the
+    carcass top or worktop at about the same distance while inside the body (:func:`_profile_end`).
+    Only when nothing at all is above the part (a wall cabinet whose top no camera saw) are rays cast
+    down instead, to its bottom board: below a base unit they would follow plinths and toe-kicks (on a
+    scene-synthesizer kitchen they cut two 0.69 m base cavities to 0.19 m), and they count only when they
+    hit above ``floor`` + ``body_floor_m`` (the floor under furniture was never seen: where its scan ends
+    is not where the body does). Where neither profile ends
+    (a tall unit whose top is above every camera: up-rays reach the ceiling inside and behind it alike),
+    rays sideways from 3 points up the part's height do, if they hit the part's own side panels (within
+    half its width + ``body_side_reach_m``; a unit inside a run sees no panel of its own there): the
+    nearer side that ends is the body's depth. Fronts facing up or down (flaps in a worktop) have no
+    such profile."""
     up = np.asarray(up, float) / np.linalg.norm(up)
     if abs(float(np.dot(pf.n, up))) > 0.5:
         return np.inf
     side = pf.u if abs(np.dot(pf.u, up)) <= abs(np.dot(pf.v, up)) else pf.v  # horizontal in-plane axis
-    width = pf.su if side is pf.u else pf.sv
+    width, height = (pf.su, pf.sv) if side is pf.u else (pf.sv, pf.su)
+    vertical = np.cross(pf.n, side)
     start = max(cfg.ignore_hits_thickness_factor * pf.thickness, 0.02)
     cs = np.arange(start, cfg.max_depth_m + cfg.body_step_m, cfg.body_step_m)
     if len(cs) < 4:
         return np.inf
-    lat = np.array([-cfg.body_lateral_factor, 0.0, cfg.body_lateral_factor]) * width
-    origins = (pf.back + cs[:, None, None] * pf.n + lat[None, :, None] * side).reshape(-1, 3)
-    for d in (up, -up):
-        t = np.asarray(cast(origins, np.tile(d, (len(origins), 1))), float).reshape(len(cs), len(lat))
-        t = np.median(np.where(np.isfinite(t), t, np.inf), axis=1)
-        t0 = float(np.median(t[:3]))
-        if not np.isfinite(t0):
-            continue  # nothing above the part: follow what is below instead
-        out = np.flatnonzero(~(t <= t0 + cfg.body_jump_m))
-        out = out[out >= 3]
-        return float(cs[out[0]] - 0.5 * cfg.body_step_m) if len(out) else np.inf
-    return np.inf
+    lat = np.array([-cfg.body_lateral_factor, 0.0, cfg.body_lateral_factor])
+    t0, end = _profile_end(pf, cast, cs, lat * width, side, up, cfg)
+    if np.isfinite(end):
+        return end
+    if not np.isfinite(t0):  # nothing above the part: follow what is below instead
+        t0, end = _profile_end(pf, cast, cs, lat * width, side, -up, cfg)
+        above_floor = float(pf.center @ up) - t0 > floor + cfg.body_floor_m
+        if np.isfinite(end) and above_floor:
+            return end
+    ends = []
+    for d in (side, -side):
+        t0, end = _profile_end(pf, cast, cs, lat * height, vertical, d, cfg)
+        if t0 <= 0.5 * width + cfg.body_side_reach_m:
+            ends.append(end)
+    return float(min(ends)) if ends else np.inf
 
 
 def estimate_cavity(pf: PartFrame, cast: callable, bounds: np.ndarray, frame: Frame | None,  # type: ignore[valid-type]
                     depth: np.ndarray | None, cfg: CavityConfig) -> tuple[float, str, dict[str, float]]:
     """(d_in, which bound set it, all four bounds)."""
     terms = {"hit": d_hit(pf, cast, cfg), "image": d_image(pf, frame, depth, cfg), "mesh": d_mesh(pf, bounds),
-             "body": d_body(pf, cast, cfg)}
+             "body": d_body(pf, cast, cfg, floor=float(bounds[0][2]))}
     src = min(terms, key=terms.get)
     d = terms[src]
     if not np.isfinite(d) or d <= 0.02:

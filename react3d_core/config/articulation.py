@@ -17,13 +17,26 @@ class ArticulationConfig(StageConfig):
     upright_tolerance: float = Field(0.1, ge=0, description="A vertical front keeps a gravity-aligned box unless the "
                                                             "minimal box is smaller by more than this share of its "
                                                             "volume (0: always the minimal box, as the paper).")
+    sliding_min_height_m: float = Field(0.3, ge=0, description="A 'sliding' prediction is kept only with its axis in the "
+                                                              "front plane and on a front at least this tall (a lower "
+                                                              "vertical front sliding sideways is a drawer front, which "
+                                                              "is pulled out along its normal instead).")
 
 
 class LimitConfig(StageConfig):
     """Motion limits (the paper leaves them open)."""
 
     revolute_max_deg: float = Field(110.0, gt=0, le=180, description="Cap on revolute opening angle.")
-    revolute_step_deg: float = Field(5.0, gt=0, description="Sweep step when searching the collision-free opening.")
+    revolute_step_deg: float = Field(5.0, gt=0, description="Coarsest turn between two samples of the sweep that searches the collision-free opening.")
+    sweep_step_m: float = Field(0.004, gt=0, description="Finest sweep sample: the fastest point of a part moves this far (at most "
+                                                         "half of collision_clearance_m - 2 mm, so a point lands inside the band where "
+                                                         "it blocks, not on or in the obstacle); far from obstacles samples are coarser.")
     collision_clearance_m: float = Field(0.01, ge=0, description="Clearance kept from background/neighbours in the sweep.")
-    prismatic_margin_m: float = Field(0.02, ge=0, description="Prismatic limit = cavity depth - margin.")
-    prismatic_min_m: float = Field(0.05, ge=0, description="Smallest prismatic travel written.")
+    revolute_min_deg: float = Field(15.0, ge=0, description="Minimum useful opening: a door whose sweep is blocked before it is "
+                                                            "reported 'blocked' (it keeps its free range).")
+    prismatic_margin_m: float = Field(0.02, ge=0, description="Prismatic limit = cavity depth (never more than the furniture's depth) - margin.")
+    prismatic_min_m: float = Field(0.05, ge=0, description="Smallest prismatic travel written (never past the back of the cavity); "
+                                                           "a drawer blocked before it is reported 'blocked'.")
+    prismatic_max_m: float = Field(0.6, gt=0, description="Largest prismatic travel where the furniture's depth behind the front was "
+                                                          "not measured (d_body): a ray through an unseen back to a far wall must not "
+                                                          "give a drawer a metre of travel (furniture is rarely deeper than 0.65 m).")

@@ -17,3 +17,9 @@ class CavityConfig(StageConfig):
     body_step_m: float = Field(0.02, gt=0, description="d_body: depth step of the up-ray profile behind the front (at most prismatic_margin_m keeps travel inside the body).")
     body_jump_m: float = Field(0.15, gt=0, description="d_body: an up-ray this much farther than inside the carcass (or missing) is past the furniture's back.")
     body_lateral_factor: float = Field(0.3, ge=0, le=0.5, description="d_body: up-rays at 0 and +-factor x the front's width from its centre (median).")
+    body_floor_m: float = Field(0.05, ge=0, description="d_body: down-rays (where nothing is above the part) count only where they hit "
+                                                        "this far above the scan's lowest point (a bottom board, not the floor, "
+                                                        "whose scan ends somewhere under the furniture).")
+    body_side_reach_m: float = Field(0.1, ge=0, description="d_body, where neither the up- nor the down-rays end: sideways rays "
+                                                           "count only if they hit a side panel within half the front's width "
+                                                           "+ this (the part's own carcass, not a neighbour or the room).")

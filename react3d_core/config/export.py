@@ -32,7 +32,32 @@ class ExportConfig(StageConfig):
         "under load, the cell atlas 0.01-0.06 s for the same parts with a same-sized texture; xatlas crashed at 80k.",
     )
     min_collision_thickness: float = Field(0.005, gt=0, description="Convex pieces thinner than this (m) become boxes this thick (flat scans have no volume).")
-    background_patch_m: float = Field(0.5, gt=0, description="MJCF background collision: grid cell (m) of the planar convex patches.")
+    background_patch_m: float = Field(0.5, gt=0, description="MJCF/URDF background collision: grid cell (m) of the planar convex patches.")
+    background_patch_min_m: float = Field(
+        0.03, gt=0,
+        description="Smallest patch cell (m): a patch near a part's path or a carcass, or spanning several parallel surfaces, is refitted "
+        "in cells half as large down to this, so the background hugs the gaps around fronts instead of bridging them.",
+    )
+    background_slab_m: float = Field(
+        0.02, gt=0,
+        description="MJCF/URDF background patches are slabs this thick (m) behind their surface: a slab cut back near a part (the floor under "
+        "a door's swing) still leaves a surface, and a fast body does not tunnel through a wall.",
+    )
+    background_patch_flatness_m: float = Field(
+        0.02, gt=0, description="A background patch whose faces lie further apart than this (m) along its normal (a front and the wall behind it) is split.",
+    )
+    collider_clearance_m: float = Field(
+        0.005, ge=0,
+        description="Gap (m) kept between colliders at rest and around every part's swept volume: background patches and triangles, "
+        "carcasses and overlapping part hulls are cut back so that nothing static stands in a part's path and no pair starts in contact "
+        "(overlaps at rest gave hundreds of contacts and jammed joints in every engine).",
+    )
+    part_trim_max_fraction: float = Field(
+        0.3, ge=0, le=1,
+        description="Where a part's path meets another part at rest (a drawer's box passing its neighbour's edge, a door's back edge "
+        "swinging past the next door), the piece that loses less volume is cut, if that is at most this fraction of it. Deeper "
+        "conflicts are left for the joint limits to settle.",
+    )
     ros_launch: bool = Field(True, description="Write RViz launch files beside the URDF.")
     write_glb: bool = Field(
         False, description="Also write a GLB per link into the shared assets (viewers only: no simulator reads it; it re-embeds geometry and texture, 41 MB on a 490k-face scan)."

@@ -134,7 +134,8 @@ class ImageConfig(StageConfig):
     enabled: bool = Field(True, description="Also find fronts in the colour frames (real scans have no seams in the mesh).")
     texture_factor: float = Field(3.0, ge=0, description="Handle/seam thresholds rise to this many times the plane's median response (textured planes).")
     face_depth: tuple[float, float] = Field((-0.02, 0.07), description="Faces this far behind/in front of the plane are taken into a front (m).")
-    coverage_close: float = Field(0.02, ge=0, description="The plane's coverage (its faces' centroids on the orthophoto grid) is closed over this (m).")
+    surface_rays: bool = Field(False, description="A plane's coverage and the handles standing out of it are read from rays cast along its normal through every orthophoto pixel (the same on any tessellation of the scan); off: from its faces' centroids splatted on the grid (a decimated scan's planes come out mostly uncovered).")
+    coverage_close: float = Field(0.02, ge=0, description="The plane's coverage (its faces' centroids, or with surface_rays the scan surface lying flat in its slab, on the orthophoto grid) is closed over this (m).")
     outline_fill_px: int = Field(20, ge=0, description="Holes and notches up to this many orthophoto px wide are inside a plane's outline (handle shadows).")
     min_faces: int = Field(4, ge=1, description="An image front holds at least this many mesh faces.")
     mesh_share: float = Field(0.3, ge=0, le=1, description="An image front lying on a mesh front's faces by more than this share of its faces is left to the mesh front (which stands unless it holds two image fronts with handles).")
@@ -167,6 +168,7 @@ class PlanesConfig(StageConfig):
     min_area: float = Field(0.08, ge=0, description="Smallest vertical plane photographed (m^2; at least fronts.min_w x fronts.min_h).")
     cell: float = Field(0.04, gt=0, description="Pieces of one plane farther apart than this are separate planes (m).")
     min_fragment_area: float = Field(0.03, ge=0, description="Fragments of a plane's coverage smaller than this are not part of it (m^2).")
+    slope_win: float = Field(0.012, gt=0, description="A plane's coverage is the scan surface in its slab (offset_tol) tilted by at most angle_tol_deg, the tilt measured on the surface's offsets averaged over this window (m; at least 3 orthophoto px).")
 
 
 class OrthoConfig(StageConfig):
@@ -174,7 +176,12 @@ class OrthoConfig(StageConfig):
 
     resolution: float = Field(0.004, gt=0, description="Metres per pixel of the fused plane orthophotos.")
     max_side_px: int = Field(1200, ge=1, description="Orthophotos of very large planes get a coarser grid, at most this many px a side.")
-    max_views: int = Field(30, ge=1, description="Views fused per plane, best first.")
+    max_views: int = Field(30, ge=1, description="Views fused per plane at most.")
+    pick_spread: bool = Field(False, description="Views are picked for coverage, sharpness and diversity (pick_*); off: the max_views frames seeing most of the plane most frontally (a dense walk's neighbouring frames, all alike).")
+    pick_samples: int = Field(9, ge=1, description="Views are picked on this many x this many sample points of a plane ...")
+    pick_need: int = Field(8, ge=1, description="... each wanting this many views; a view is worth the sum of its sharpness (cosine to the normal over distance) at the samples that still want views ...")
+    pick_sep: float = Field(0.15, ge=0, description="... and once one is taken, views whose camera is within this (m) ...")
+    pick_sep_deg: float = Field(10.0, ge=0, description="... and whose optical axis is within this (deg) of it are passed over (a dense walk's next frames add nothing new).")
     min_cos: float = Field(0.3, ge=0, le=1, description="Views more grazing than this cos to the plane are not used.")
     render_scale: float = Field(0.5, gt=0, le=1, description="Face-id buffer size relative to the colour image.")
     erode_px: int = Field(3, ge=0, description="Depth-buffer pixels kept this far from depth jumps (occluder outlines).")

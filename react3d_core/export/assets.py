@@ -32,7 +32,7 @@ class LinkFiles:
     textures: list[str] = field(default_factory=list)  # texture paths, same order (the OBJ's own format)
     mjcf_textures: list[str] = field(default_factory=list)  # PNG paths, same order (MuJoCo reads PNG only)
     collisions: list[str] = field(default_factory=list)  # convex OBJ per piece
-    patches: list[str] = field(default_factory=list)  # background convex patches, one OBJ each
+    patches: list[str] = field(default_factory=list)  # background convex patches that are not boxes, one OBJ each
 
     def prefixed(self, prefix: str) -> "LinkFiles":
         """The same files seen from another folder (``prefix`` = ``"../"`` from ``export/<format>/``)."""
@@ -75,6 +75,8 @@ def write_link_assets(model: SceneModel, folder: Path, config: ExportConfig | No
                 p = write_plain_obj(d / f"collision_{k}.obj", piece.vertices - link.frame, piece.faces)
                 files.collisions.append(p.relative_to(folder).as_posix())
             for k, piece in enumerate(link.patches):
+                if piece.box is not None:
+                    continue  # written as a box primitive
                 p = write_plain_obj(d / "patches" / f"patch_{k}.obj", piece.vertices - link.frame, piece.faces)
                 files.patches.append(p.relative_to(folder).as_posix())
         out[link.name] = files

@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import hashlib
 import zipfile
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 
 import numpy as np
@@ -33,10 +34,25 @@ class ConvexPiece:
     vertices: np.ndarray
     faces: np.ndarray
     source: str  # "component", "hull", "coacd", "box", "patch"
+    box: np.ndarray | None = None  # (15,) centre, rotation (3x3, row-major; columns are the box axes), extents: an exact box
 
-    @property
+    @cached_property
     def volume(self) -> float:
         return float(trimesh.Trimesh(self.vertices, self.faces, process=False).volume)
+
+    @cached_property
+    def axes(self) -> np.ndarray:
+        """Its face-normal directions, duplicates and opposites removed (3 for a box)."""
+        from .clearance import unique_axes
+
+        v, f = self.vertices, self.faces
+        n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+        return unique_axes(n[np.linalg.norm(n, axis=1) > 1e-12], tol=1e-5)
+
+    def box_frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(centre, rotation, extents) of a box piece (writers emit it as a box primitive)."""
+        assert self.box is not None
+        return self.box[:3], self.box[3:12].reshape(3, 3), self.box[12:]
 
 
 def _pca_frame(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -123,28 +139,23 @@ def _coacd(comp: trimesh.Trimesh, max_pieces: int, min_thickness: float) -> list
     return [convex_piece(np.asarray(v), min_thickness, "coacd") for v, _ in parts]
 
 
-def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[ConvexPiece]:
-    """Static background for engines that convexify every collision mesh (MuJoCo, PyBullet child links).
+def _fit_slabs(tri: np.ndarray, n: np.ndarray, cell: float, min_thickness: float, slab: float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """One slab box per group of triangles (grid cell of the centroid x dominant normal direction).
 
-    Simplified path: faces are grouped by the grid cell of their centroid and by dominant normal
-    direction (+-x, +-y, +-z); each group becomes the PCA box (slab) of its corner points, at least
-    ``min_thickness`` thick, so floors and walls become slabs and a corner never becomes a solid
-    wedge. All groups are fitted at once (batched covariance / eigh / segment min-max).
-    """
-    v, f = mesh.vertices, mesh.faces
-    if not len(f):
-        return []
-    tri = v[f]
-    n = mesh.face_cross
-    keep = np.linalg.norm(n, axis=1) > 1e-15
-    tri, n = tri[keep], n[keep]
-    if not len(tri):
-        return []
+    Returns per group: corners (G,8,3), axes (G,3,3) (rows: normal, two in-plane axes), the
+    surface's own thickness along the normal (G,), per triangle its group (T,), and the boxes
+    (G,15) as ``ConvexPiece.box``. The normal
+    points out of the surface (the side its faces face) and the slab lies behind the surface:
+    its outer face is the outermost point of the surface, so a surface's collider never stands
+    in front of it, and is at least ``slab`` thick. In-plane extents below ``min_thickness`` are padded
+    symmetrically."""
     axis = np.argmax(np.abs(n), axis=1)
     direction = axis * 2 + (n[np.arange(len(n)), axis] > 0)
     cells = np.floor(tri.mean(1) / cell).astype(np.int64)
-    _, g = np.unique(np.column_stack([cells, direction]), axis=0, return_inverse=True)
-    g = np.repeat(g.ravel(), 3)
+    _, g_tri = np.unique(np.column_stack([cells, direction]), axis=0, return_inverse=True)
+    g_tri = g_tri.ravel()
+    g = np.repeat(g_tri, 3)
     P = tri.reshape(-1, 3)
     G = int(g.max()) + 1
     cnt = np.bincount(g, minlength=G).astype(float)
@@ -156,6 +167,8 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[Con
             cov[:, a, b] = cov[:, b, a] = np.bincount(g, D[:, a] * D[:, b], G) / cnt
     _, E = np.linalg.eigh(cov)
     nrm = E[:, :, 0]  # smallest variance: the patch normal
+    facing = np.stack([np.bincount(g_tri, n[:, k], G) for k in range(3)], 1)  # area-weighted face normals
+    nrm = nrm * np.where(np.sum(nrm * facing, 1) < 0, -1.0, 1.0)[:, None]
     # in-plane axes follow the grid (the world axis most perpendicular to the normal), so square
     # cells give tight boxes; PCA's in-plane axes are arbitrary for a square and overshoot by 41 %
     k = np.argmin(np.abs(nrm), axis=1)
@@ -167,15 +180,86 @@ def planar_patches(mesh: TriMesh, cell: float, min_thickness: float) -> list[Con
     starts = np.flatnonzero(np.r_[True, np.diff(g[order]) != 0])
     lo = np.minimum.reduceat(local[order], starts, axis=0)
     hi = np.maximum.reduceat(local[order], starts, axis=0)
-    ext = np.maximum(hi - lo, min_thickness)
+    thickness = hi[:, 0] - lo[:, 0]
+    lo[:, 0] = np.minimum(lo[:, 0], hi[:, 0] - slab)  # behind the surface
+    pad = np.maximum(min_thickness - (hi[:, 1:] - lo[:, 1:]), 0) / 2
+    lo[:, 1:] -= pad
+    hi[:, 1:] += pad
+    unit = np.asarray(trimesh.creation.box(extents=(1.0, 1.0, 1.0)).vertices) + 0.5  # corners in [0, 1]^3
+    local_corners = lo[:, None, :] + unit[None] * (hi - lo)[:, None, :]
+    corners = mu[:, None, :] + np.einsum("gcj,gij->gci", local_corners, R)
     centre = mu + np.einsum("gij,gj->gi", R, (lo + hi) / 2)
-    unit = trimesh.creation.box(extents=(1.0, 1.0, 1.0))
-    corners = centre[:, None, :] + np.einsum("cj,gj,gij->gci", np.asarray(unit.vertices), ext, R)
-    faces = np.asarray(unit.faces)
-    return [ConvexPiece(c, faces, "patch") for c in corners]
+    boxes = np.concatenate([centre, R.reshape(G, 9), hi - lo], axis=1)
+    return corners, np.transpose(R, (0, 2, 1)), thickness, g_tri, boxes
 
 
-COLLISION_VERSION = "1"
+def _slab_pieces(corners: np.ndarray, boxes: np.ndarray) -> list[ConvexPiece]:
+    faces = np.asarray(trimesh.creation.box(extents=(1.0, 1.0, 1.0)).faces)
+    return [ConvexPiece(c, faces, "patch", b) for c, b in zip(corners, boxes)]
+
+
+def planar_patches(mesh: TriMesh, cell: float, min_thickness: float, min_cell: float | None = None,
+                   flatness: float | None = None, obstacles: Sequence = (), margin: float = 0.0,
+                   faces: np.ndarray | None = None, extra: np.ndarray | None = None, slab: float | None = None) -> list[ConvexPiece]:
+    """Static background for engines that convexify every collision mesh (MuJoCo, PyBullet child links).
+
+    Faces are grouped by the grid cell of their centroid and by dominant normal direction (+-x, +-y,
+    +-z); each group becomes a slab box behind its surface (at least ``slab`` thick, default
+    ``min_thickness``), so
+    floors and walls become slabs and a corner never becomes a solid wedge. All groups are fitted
+    at once (batched covariance / eigh / segment min-max).
+
+    Refinement (``min_cell`` given): a slab thicker than ``flatness`` (several parallel surfaces in
+    one cell: a front and the wall behind it) is refitted from its faces in cells half as large, down
+    to 4 x ``min_cell``; one within ``margin`` of an obstacle (``clearance.Obstacle``: a part's path, a
+    cavity) is cut back (``clearance.keep_clear``) if that keeps ``REFINE_KEEP`` of it, else refitted
+    too (at ``min_cell``, cut back whatever it keeps).
+    ``faces``: indices of the faces to use (default all); ``extra``: more triangles (k,3,3).
+    """
+    from .clearance import ObstacleSet, box_conflicts, keep_clear
+
+    f = mesh.faces if faces is None else mesh.faces[np.asarray(faces, np.int64)]
+    tri = mesh.vertices[f]
+    if extra is not None and len(extra):
+        tri = np.concatenate([tri, np.asarray(extra, float)])
+    if not len(tri):
+        return []
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    keep = np.linalg.norm(n, axis=1) > 1e-15
+    tri, n = tri[keep], n[keep]
+    if not len(tri):
+        return []
+    out: list[ConvexPiece] = []
+    obs = ObstacleSet(obstacles)
+    size = cell
+    while len(tri):
+        corners, axes, thickness, g_tri, boxes = _fit_slabs(tri, n, size, min_thickness, min_thickness if slab is None else slab)
+        last = min_cell is None or size / 2 < min_cell
+        # parallel surfaces are told apart down to 4 x min_cell (a front frame and the wall behind it);
+        # only obstacles refine further (a slab standing across a gap that a part moves through)
+        split = np.zeros(len(corners), bool) if last or flatness is None or size / 2 < 4 * min_cell else thickness > flatness
+        near = box_conflicts(corners, axes, obstacles, margin) if len(obstacles) else np.zeros(len(corners), bool)
+        out += _slab_pieces(corners[~split & ~near], boxes[~split & ~near])
+        for g in np.flatnonzero(near & ~split):  # cut back; refine instead where a cut would lose much
+            (piece,) = _slab_pieces(corners[g : g + 1], boxes[g : g + 1])
+            cut, _ = keep_clear([piece], obs, margin)
+            if last or sum(c.volume for c in cut) >= REFINE_KEEP * piece.volume:
+                out += cut
+            else:
+                split[g] = True
+        if last or not split.any():
+            break
+        sel = split[g_tri]
+        tri, n = tri[sel], n[sel]
+        size /= 2
+    return out
+
+
+REFINE_KEEP = 0.7
+"""A background slab near an obstacle is cut back when that keeps this share of it, else refitted in smaller cells."""
+
+
+COLLISION_VERSION = "3"
 """Bump when convex_pieces / planar_patches change their output: it is part of the cache key."""
 
 
@@ -203,7 +287,8 @@ def cached_pieces(cache_dir: str | Path | None, kind: str, mesh: TriMesh, params
                 counts_v, counts_f = z["counts_v"], z["counts_f"]
                 vs = np.split(z["vertices"], np.cumsum(counts_v)[:-1]) if len(counts_v) else []
                 fs = np.split(z["faces"], np.cumsum(counts_f)[:-1]) if len(counts_f) else []
-                return [ConvexPiece(v, f, str(s)) for v, f, s in zip(vs, fs, z["sources"])]
+                boxes = z["boxes"] if "boxes" in z.files else np.full((len(vs), 15), np.nan)
+                return [ConvexPiece(v, f, str(s), None if np.isnan(b).any() else b) for v, f, s, b in zip(vs, fs, z["sources"], boxes)]
         except (OSError, ValueError, KeyError, zipfile.BadZipFile):
             pass  # unreadable: recompute below and overwrite
     pieces = compute()
@@ -216,5 +301,6 @@ def cached_pieces(cache_dir: str | Path | None, kind: str, mesh: TriMesh, params
                 counts_v=np.array([len(p.vertices) for p in pieces], np.int64),
                 counts_f=np.array([len(p.faces) for p in pieces], np.int64),
                 sources=np.array([p.source for p in pieces], dtype=str),
+                boxes=np.array([p.box if p.box is not None else np.full(15, np.nan) for p in pieces]).reshape(-1, 15),
             )
     return pieces

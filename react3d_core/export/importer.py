@@ -26,7 +26,7 @@ def _origin(el: ET.Element | None) -> np.ndarray:
 def import_urdf(path: str | Path) -> dict[str, Articulation]:
     """Joint name -> Articulation (world axis/origin at q = 0, limits) for every revolute/prismatic joint.
 
-    REACT3D joints are named ``<object_id>__joint``; the suffix is stripped. Continuous joints are
+    REACT3D joints are named ``<object_id>_joint``; the suffix is stripped. Continuous joints are
     skipped (no limits); world poses follow the kinematic tree from the root link.
     """
     path = Path(path)
@@ -62,7 +62,7 @@ def import_urdf(path: str | Path) -> dict[str, Articulation]:
         if lim is None:
             raise InputError(path, f"joint {j.get('name')} has no <limit>")
         name = j.get("name", "")
-        key = name[: -len("__joint")] if name.endswith("__joint") else name
+        key = name[: -len("_joint")] if name.endswith("_joint") else name
         out[key] = Articulation(
             joint_type=kind, axis=tuple(T[:3, :3] @ axis), origin=tuple(T[:3, 3]),
             lower=float(lim.get("lower", 0)), upper=float(lim.get("upper", 0)), limit_source="urdf",

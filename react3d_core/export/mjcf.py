@@ -1,8 +1,15 @@
 """MJCF writer for MuJoCo: static background, per object a static base body and a moving part body.
 
 MuJoCo convexifies every mesh, so collision pieces are inline convex meshes (one geom each) and the
-static background collides through its planar patches; the textured OBJ visuals (group 1) do not
-collide. Joint frames match the URDF: the part body sits at the articulation origin.
+static background collides through its planar patches (box geoms; a patch cut back near a part is an
+inline convex mesh); the textured OBJ visuals (group 1) do not collide. Joint frames match the URDF: the part body sits at the articulation origin.
+
+Collision policy, stated in the file: every collision geom has ``contype="1" conaffinity="1"`` (a
+robot with the defaults collides with every part, carcass and the background); a part and its own
+carcass are excluded (``<contact><exclude>``): MuJoCo's parent-child filter does not apply to a
+carcass welded to the world, while PyBullet (parent exclusion) and PhysX (jointed bodies) skip that
+pair, so all engines agree. Static bodies (background, carcasses) never collide with each other in
+MuJoCo. The colliders are separated at export (``clearance``), so nothing starts in contact.
 """
 
 from __future__ import annotations
@@ -11,6 +18,7 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from ..atomic import write_text
 from ..config.export import ExportConfig
@@ -37,14 +45,15 @@ def _assets(link: Link, files: LinkFiles) -> list[str]:
     for k, (obj, png) in enumerate(zip(files.visuals, files.mjcf_textures)):
         n = f"{link.name}_visual_{k}"
         out += [
-            f'    <mesh name="{n}" file={quoteattr(obj)}/>',
+            f'    <mesh name="{n}" file={quoteattr(obj)} inertia="shell"/>',  # visual only: a flat scan has no volume
             f'    <texture name="{n}_tex" type="2d" file={quoteattr(png)}/>',
             f'    <material name="{n}_mat" texture="{n}_tex"/>',
         ]
     for k, piece in enumerate(link.collisions):
         out.append(_inline_mesh(f"{link.name}_col_{k}", piece, link.frame))
     for k, piece in enumerate(link.patches):
-        out.append(_inline_mesh(f"{link.name}_patch_{k}", piece, link.frame))
+        if piece.box is None:
+            out.append(_inline_mesh(f"{link.name}_patch_{k}", piece, link.frame))
     return out
 
 
@@ -55,8 +64,14 @@ def _geoms(link: Link, files: LinkFiles, indent: str) -> list[str]:
         out.append(f'{indent}<geom name="{n}" type="mesh" mesh="{n}" material="{n}_mat" class="visual"/>')
     for k in range(len(link.collisions)):
         out.append(f'{indent}<geom name="{link.name}_col_{k}" type="mesh" mesh="{link.name}_col_{k}" class="collision"/>')
-    for k in range(len(link.patches)):
-        out.append(f'{indent}<geom name="{link.name}_patch_{k}" type="mesh" mesh="{link.name}_patch_{k}" class="collision"/>')
+    for k, piece in enumerate(link.patches):
+        n = f"{link.name}_patch_{k}"
+        if piece.box is None:
+            out.append(f'{indent}<geom name="{n}" type="mesh" mesh="{n}" class="collision"/>')
+            continue
+        c, R, ext = piece.box_frame()
+        x, y, z, w = Rotation.from_matrix(R).as_quat()
+        out.append(f'{indent}<geom name="{n}" type="box" pos="{_v(c - link.frame)}" quat="{_v([w, x, y, z])}" size="{_v(ext / 2)}" class="collision"/>')
     return out
 
 
@@ -75,7 +90,7 @@ def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
         '  <option timestep="0.002" gravity="0 0 -9.81"/>',
         "  <default>",
         '    <default class="visual"><geom contype="0" conaffinity="0" group="1" density="0"/></default>',
-        '    <default class="collision"><geom group="3" rgba="0.5 0.5 0.5 0.3" density="0"/></default>',
+        '    <default class="collision"><geom contype="1" conaffinity="1" group="3" rgba="0.5 0.5 0.5 0.3" density="0"/></default>',
         f'    <joint damping="{_f(config.joint_damping)}"/>',
         "  </default>",
         "  <asset>",
@@ -109,7 +124,13 @@ def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
             out += body(link, np.zeros(3), "    ")
     for c in children.get("background", []):
         out += body(c, np.zeros(3), "    ")
-    out += ["  </worldbody>", "</mujoco>"]
+    out.append("  </worldbody>")
+    excluded = [j for j in model.joints if model.link(j.parent).role == "base"]
+    if excluded:
+        out.append("  <contact>")
+        out += [f'    <exclude name="{j.child}_own_carcass" body1="{j.parent}" body2="{j.child}"/>' for j in excluded]
+        out.append("  </contact>")
+    out.append("</mujoco>")
     return "\n".join(out) + "\n"
 
 

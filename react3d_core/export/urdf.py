@@ -3,10 +3,18 @@
 Joint frames: the joint origin is the articulation origin with no rotation, the axis is the world
 axis (= the joint-frame axis), and the part link's meshes are stored relative to that origin, so
 q = 0 is the scanned state and the motion equals ``Articulation.move``. The static background
-collides through convex planar patches: PyBullet ignores ``concave="yes"`` on a non-root link and
+collides through convex planar patches (``<box>`` primitives; a patch cut back near a part is a
+convex OBJ): PyBullet ignores ``concave="yes"`` on a non-root link and
 MuJoCo convexifies every mesh, so one triangle-mesh collider became the room's solid hull (measured:
 a dropped ball was expelled through the floor). The ``<mujoco>`` block keeps
 visuals and the static bodies when MuJoCo imports this URDF.
+
+Collision policy: URDF has no element for it, so it is what the engines do, written into the file
+as a comment. PyBullet collides links of one body only with ``URDF_USE_SELF_COLLISION`` (add
+``URDF_USE_SELF_COLLISION_EXCLUDE_PARENT`` so a part and its carcass do not collide); SAPIEN/PhysX
+collide all links of an articulation except a joint's two; MuJoCo's URDF import collides a part with
+its carcass (add an ``<exclude>`` or use the MJCF). The colliders are separated at export
+(``clearance``), so self-collision on starts without contacts.
 """
 
 from __future__ import annotations
@@ -15,10 +23,12 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from ..atomic import write_text
 from ..config.export import ExportConfig
 from .assets import LinkFiles
+from .collision import ConvexPiece
 from .model import Link, SceneModel
 
 
@@ -44,9 +54,22 @@ def _inertial(link: Link) -> list[str]:
     ]
 
 
+def _box(piece: ConvexPiece, frame: np.ndarray) -> tuple[str, str, str]:
+    """(xyz, rpy, geometry) of a box piece: URDF's rpy is fixed-axis roll, pitch, yaw (R = Rz Ry Rx)."""
+    c, R, ext = piece.box_frame()
+    return _v(c - frame), _v(Rotation.from_matrix(R).as_euler("xyz")), f'<box size="{_v(ext)}"/>'
+
+
+POLICY = (
+    "<!-- Collision policy: colliders are separated at rest and around every part's path. Load with self-collision on and "
+    "parent exclusion (PyBullet: URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_EXCLUDE_PARENT; SAPIEN/PhysX do this by "
+    "default) so a part never collides with its own carcass (its parent link) and collides with everything else. -->"
+)
+
+
 def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConfig, prefix: str = "") -> str:
     """The URDF document; mesh paths are ``prefix + relative path`` (``package://pkg/`` for ROS)."""
-    out = ['<?xml version="1.0"?>', f"<robot name={quoteattr(model.scene_id)}>"]
+    out = ['<?xml version="1.0"?>', POLICY, f"<robot name={quoteattr(model.scene_id)}>"]
     out += ["  <mujoco>", '    <compiler strippath="false" discardvisual="false" fusestatic="false" balanceinertia="true"/>', "  </mujoco>"]
     out += ['  <link name="world"/>']
     for link in model.links:
@@ -60,24 +83,26 @@ def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
                 f'      <geometry><mesh filename="{prefix}{vis}"/></geometry>',
                 "    </visual>",
             ]
-        cols = f.patches + f.collisions
-        for k, col in enumerate(cols):
+        meshes = iter(f.patches)
+        cols = [_box(p, link.frame) if p.box is not None else ("0 0 0", "0 0 0", f'<mesh filename="{prefix}{next(meshes)}"/>') for p in link.patches]
+        cols += [("0 0 0", "0 0 0", f'<mesh filename="{prefix}{col}"/>') for col in f.collisions]
+        for k, (xyz, rpy, geometry) in enumerate(cols):
             out += [
                 f'    <collision name="{link.name}_collision_{k}">',
-                '      <origin xyz="0 0 0" rpy="0 0 0"/>',
-                f'      <geometry><mesh filename="{prefix}{col}"/></geometry>',
+                f'      <origin xyz="{xyz}" rpy="{rpy}"/>',
+                f"      <geometry>{geometry}</geometry>",
                 "    </collision>",
             ]
         out.append("  </link>")
     out += [
-        '  <joint name="world__background" type="fixed">',
+        '  <joint name="background_fixed" type="fixed">',
         '    <parent link="world"/><child link="background"/><origin xyz="0 0 0" rpy="0 0 0"/>',
         "  </joint>",
     ]
     for link in model.links:
         if link.role == "base":
             out += [
-                f'  <joint name="{link.name}__fixed" type="fixed">',
+                f'  <joint name="{link.name}_fixed" type="fixed">',
                 f'    <parent link="background"/><child link="{link.name}"/><origin xyz="{_v(link.frame)}" rpy="0 0 0"/>',
                 "  </joint>",
             ]

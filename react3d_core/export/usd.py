@@ -1,12 +1,19 @@
 """USD writer (usd-core, UsdPhysics): one stage in metres, z up, kilograms.
 
-Per object: an Xform carrying ``ArticulationRootAPI`` (exactly one root per articulation) holding a
-base rigid body fixed to the world, a part rigid body and its revolute/prismatic joint. UsdPhysics
+Per object: an Xform ``/World/<object>`` carrying ``ArticulationRootAPI`` (exactly one root per
+articulation) holding the carcass body ``<object>_base`` fixed to the world, the part body ``<object>``
+and its revolute/prismatic joint ``<object>_joint`` (the URDF's and MJCF's link and joint names). UsdPhysics
 joint axes are only X/Y/Z, so both local joint frames are rotated to map +X onto the articulation
 axis (an axis near -X uses a half turn about Z, where the shortest-arc formula breaks down); body0's
 and body1's frames are the same world frame, so PhysX does not move bodies at load. Moving bodies
 get convex colliders only; the static background collides through its own visual triangle mesh (one
-copy of the scan in the file, not two). Mesh data lives inside the stage (usd-core cannot reference
+copy of the scan in the file, not two), less the faces in a part's path or inside a carcass (written
+as a second, visual-only prim). Collision policy, stated in the file: each articulation root applies
+``PhysxArticulationAPI`` with ``physxArticulation:enabledSelfCollisions = true`` (authored by name:
+PhysxSchema is not in usd-core); every joint has ``physics:collisionEnabled = false`` (a part never
+collides with its own carcass, as in PyBullet with parent exclusion and the MJCF's ``<exclude>``);
+each carcass filters the background (``FilteredPairsAPI``: two static bodies). Everything else
+collides, a robot included. Mesh data lives inside the stage (usd-core cannot reference
 OBJ/GLB), written as a binary crate ``scene.usdc`` (~4x smaller than ASCII) under a small
 ``scene.usda`` root that carries the stage metadata and sublayers it. Textures are the shared
 export assets (``../assets/<link>/visual_<k>/material_0.png``), bound through UsdPreviewSurface +
@@ -90,20 +97,29 @@ def _material(stage, name: str, texture_rel: str):  # noqa: ANN001, ANN202
     return mat
 
 
-def _visuals(stage, prim_path: str, link: Link, files: LinkFiles) -> list:  # noqa: ANN001
-    """Textured visual meshes of ``link`` (textures: the shared asset files); returns the mesh prims."""
+def _visuals(stage, prim_path: str, link: Link, files: LinkFiles, face_sets: list[tuple[str, np.ndarray]] | None = None) -> list:  # noqa: ANN001
+    """Textured visual meshes of ``link`` (textures: the shared asset files); returns the mesh prims.
+
+    ``face_sets``: (name suffix, face ids) — each visual is written as one prim per set (sharing its
+    material), so part of a surface can collide and the rest not without a second copy of it."""
     from pxr import Sdf, UsdGeom, UsdShade, Vt
 
     meshes = []
     for k, tm in enumerate(link.visuals):
         name = f"{link.name}_visual_{k}"
-        # scan topology (shared points) with face-varying st: UV seams need no duplicated points
-        _, first, inv = np.unique(tm.source_vertex, return_index=True, return_inverse=True)
-        mesh = _define_mesh(stage, f"{prim_path}/{name}", tm.vertices[first] - link.frame, inv.reshape(-1)[tm.faces])
-        st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.faceVarying)
-        st.Set(Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(tm.uv[tm.faces].reshape(-1, 2), np.float32)))
-        UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(_material(stage, name, files.textures[k]))
-        meshes.append(mesh)
+        material = _material(stage, name, files.textures[k])
+        subsets = [(name, np.arange(len(tm.faces)))] if face_sets is None else [(f"{name}{suffix}", ids) for suffix, ids in face_sets]
+        for prim_name, ids in subsets:
+            if not len(ids):
+                continue
+            faces = tm.faces[ids]
+            # scan topology (shared points) with face-varying st: UV seams need no duplicated points
+            used, first, inv = np.unique(tm.source_vertex[faces.ravel()], return_index=True, return_inverse=True)
+            mesh = _define_mesh(stage, f"{prim_path}/{prim_name}", tm.vertices[faces.ravel()[first]] - link.frame, inv.reshape(-1, 3))
+            st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.faceVarying)
+            st.Set(Vt.Vec2fArray.FromNumpy(np.ascontiguousarray(tm.uv[faces].reshape(-1, 2), np.float32)))
+            UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(material)
+            meshes.append(mesh)
     return meshes
 
 
@@ -115,6 +131,46 @@ def _colliders(stage, prim_path: str, pieces: list[ConvexPiece], frame: np.ndarr
         mesh.CreatePurposeAttr(UsdGeom.Tokens.guide)
         UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
         UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.convexHull)
+
+
+def _background(stage, bg: Link, files: LinkFiles) -> list:  # noqa: ANN001
+    """The background's visuals; the faces that collide (not in a part's path nor in a carcass) carry
+    a static triangle-mesh collider, the rest is visual only, and fragments of big faces that were
+    only partly in the way become one more guide mesh. Returns the collider prim paths."""
+    from pxr import UsdGeom, UsdPhysics
+
+    keep = bg.collide_faces
+    sets = None if keep is None else [("", np.flatnonzero(keep)), ("_visual_only", np.flatnonzero(~keep))]
+    colliders = []
+    for mesh in _visuals(stage, "/World/background", bg, files, sets):
+        if mesh.GetPrim().GetName().endswith("_visual_only"):
+            continue
+        # static triangle collider = the visual scan mesh itself (same triangles; no second copy)
+        UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
+        UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.none)
+        colliders.append(mesh.GetPath())
+    if bg.fragments is not None and len(bg.fragments):
+        frags = bg.fragments.reshape(-1, 3) - bg.frame
+        mesh = _define_mesh(stage, "/World/background/collision_fragments", frags, np.arange(len(frags)).reshape(-1, 3))
+        mesh.CreatePurposeAttr(UsdGeom.Tokens.guide)
+        UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
+        UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.none)
+        colliders.append(mesh.GetPath())
+    return colliders
+
+
+PHYSX_ARTICULATION_API = "PhysxArticulationAPI"
+"""PhysX's articulation schema (PhysxSchema, not part of usd-core): applied by its token, its attribute authored by name."""
+SELF_COLLISIONS = "physxArticulation:enabledSelfCollisions"
+
+
+def _self_collisions(prim, enabled: bool) -> None:  # noqa: ANN001
+    """State the articulation's self-collision policy for PhysX (Isaac Sim): links of one articulation
+    collide unless jointed to each other (PhysX never collides a joint's two bodies by default)."""
+    from pxr import Sdf
+
+    prim.AddAppliedSchema(PHYSX_ARTICULATION_API)
+    prim.CreateAttribute(SELF_COLLISIONS, Sdf.ValueTypeNames.Bool, custom=False).Set(bool(enabled))
 
 
 def _body(stage, path: str, link: Link, files: LinkFiles):  # noqa: ANN001, ANN202
@@ -171,34 +227,36 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig, files: 
 
     bg = model.link("background")
     UsdGeom.Xform.Define(stage, "/World/background")
-    for mesh in _visuals(stage, "/World/background", bg, files["background"]):
-        # static triangle collider = the visual scan mesh itself (same triangles; no second copy)
-        UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
-        UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.none)
+    background_colliders = _background(stage, bg, files["background"])
 
     for j in model.joints:
-        oid = j.child[: -len("__part")]
+        oid = j.child  # the part link is named after its object
         root = f"/World/{oid}"
         UsdGeom.Xform.Define(stage, root)
         UsdPhysics.ArticulationRootAPI.Apply(stage.GetPrimAtPath(root))
+        _self_collisions(stage.GetPrimAtPath(root), True)
         parent = model.link(j.parent)
         part = model.link(j.child)
         body0: str | None = None
         if parent.role == "base":
-            body0 = f"{root}/base"
+            body0 = f"{root}/{parent.name}"
             _body(stage, body0, parent, files[parent.name])
-            fixed = UsdPhysics.FixedJoint.Define(stage, f"{root}/base_fixed")
+            # static against static: the carcass never moves, so contacts with the background would only cost
+            UsdPhysics.FilteredPairsAPI.Apply(stage.GetPrimAtPath(body0)).CreateFilteredPairsRel().SetTargets(background_colliders)
+            fixed = UsdPhysics.FixedJoint.Define(stage, f"{root}/{parent.name}_fixed")
+            fixed.CreateCollisionEnabledAttr(False)
             fixed.CreateBody1Rel().SetTargets([Sdf.Path(body0)])
             fixed.CreateLocalPos0Attr(_vec3f(parent.frame))
             fixed.CreateLocalRot0Attr(Gf.Quatf(1.0))
             fixed.CreateLocalPos1Attr(Gf.Vec3f(0, 0, 0))
             fixed.CreateLocalRot1Attr(Gf.Quatf(1.0))
-        body1 = f"{root}/part"
+        body1 = f"{root}/{part.name}"
         _body(stage, body1, part, files[part.name])
         a = j.articulation
         revolute = a.joint_type == "revolute"
-        joint = (UsdPhysics.RevoluteJoint if revolute else UsdPhysics.PrismaticJoint).Define(stage, f"{root}/joint")
+        joint = (UsdPhysics.RevoluteJoint if revolute else UsdPhysics.PrismaticJoint).Define(stage, f"{root}/{j.name}")
         joint.CreateAxisAttr(UsdPhysics.Tokens.x)
+        joint.CreateCollisionEnabledAttr(False)  # a part and its own carcass never collide (as in URDF engines and the MJCF)
         if body0 is not None:
             joint.CreateBody0Rel().SetTargets([Sdf.Path(body0)])
         joint.CreateBody1Rel().SetTargets([Sdf.Path(body1)])

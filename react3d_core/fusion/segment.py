@@ -77,6 +77,16 @@ def _vertex_ids(mesh: TriMesh, faces: np.ndarray) -> np.ndarray:
     return np.unique(mesh.faces[faces].ravel()).astype(np.int64)
 
 
+GENERIC_LABELS = ("", "openable")
+
+
+def view_tag(views: Sequence) -> str:
+    """Perception's name for a part: the most frequent specific label among its top views' masks
+    (``"refrigerator door"``, a heuristic's ``"drawer"``), first seen on a tie; ``"openable"`` if none."""
+    labels = [v.mask.label for v in views if getattr(v, "mask", None) is not None and v.mask.label not in GENERIC_LABELS]
+    return max(dict.fromkeys(labels), key=labels.count) if labels else "openable"
+
+
 def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh, config: FusionConfig = FusionConfig()) -> list[PartCandidate]:
     """Proposals of several Louvain resolutions often re-segment to the same part, or to a piece of
     it (seen cut off in their best view): keep the best-scored candidate, drop later ones with
@@ -145,6 +155,7 @@ def candidates_from_proposals(
         out.append(
             PartCandidate(
                 candidate_id=len(out),
+                label=view_tag(tv),
                 score=float(np.mean([t.iou for t in tv])),
                 face_ids=kept,
                 vertex_ids=_vertex_ids(mesh, kept),

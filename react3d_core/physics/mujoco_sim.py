@@ -26,7 +26,9 @@ class MujocoSim(Sim):
         self.mj = mujoco
         self.version = mujoco.__version__
         spec = mujoco.MjSpec.from_file(str(mjcf))
-        body = spec.worldbody.add_body(name=PROBE, mass=0.1, inertia=[4e-5] * 3, ipos=[0, 0, 0], explicitinertial=True)
+        # compiled with gravity compensation: MuJoCo applies ``body_gravcomp`` only when some body had it at
+        # compile time (``ngravcomp``); set at run time alone it is ignored and a "compensated" probe falls
+        body = spec.worldbody.add_body(name=PROBE, mass=0.1, inertia=[4e-5] * 3, ipos=[0, 0, 0], explicitinertial=True, gravcomp=1.0)
         free = body.add_freejoint(name=f"{PROBE}_free")
         free.damping, free.armature, free.frictionloss = [0.0] * 3, 0.0, 0.0  # not the file's joint defaults
         geom = body.add_geom(name=PROBE, type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.03, 0, 0])

@@ -32,14 +32,15 @@ def _room_depths(layout: SynthLayout) -> list[float]:
 def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 0, n_frames: int = 60,
                    urdf_path: str | Path | None = None, kind: str | None = None, edge: float | None = None,
                    mesh: str = "clean", realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0),
-                   up: str = "z", scale: float = 1.0, depth_dropout: str = "none") -> Path:
+                   up: str = "z", scale: float = 1.0, depth_dropout: str = "none", decimate: float = 1.0) -> Path:
     """Build, render and write one synthetic scene; returns ``out_dir``.
 
     ``kind`` picks the procedural room type (default by seed), ``edge`` the triangle size of the
     furniture (smaller = denser meshes, for scaling benchmarks; default 3 cm procedural, 5 cm others).
     ``mesh`` (clean | laser | tsdf) re-makes the written scan mesh like a real scan, ``realism``
     (photo | plain) picks the image renderer, ``misregister`` shifts colour against depth by (dx, dy)
-    pixels (see :func:`.writer.write_synthetic`). ``up`` / ``scale`` (urdf only): the asset's up axis
+    pixels, ``decimate`` keeps that share of a laser / TSDF mesh's faces (quadric; see
+    :func:`.writer.write_synthetic`). ``up`` / ``scale`` (urdf only): the asset's up axis
     and unit scale (:func:`.from_urdf.build_from_urdf`). ``depth_dropout`` (none | dark): drop depth on
     dark and glossy surfaces like a ToF sensor, in the depth frames and the laser / TSDF mesh
     (:mod:`.depth_effects`).
@@ -62,7 +63,7 @@ def generate_scene(out_dir: str | Path, source: str = "procedural", seed: int = 
     else:
         raise ValueError(f"unknown source {source!r}; choose from {', '.join(SOURCES)}")
     return write_synthetic(layout, out_dir, n_frames, seed, source, room_depths=_room_depths(layout), mesh=mesh,
-                           realism=realism, misregister=misregister, depth_dropout=depth_dropout)
+                           realism=realism, misregister=misregister, depth_dropout=depth_dropout, decimate=decimate)
 
 
 def demo_scene(out_dir: str | Path) -> Path:

@@ -24,6 +24,12 @@ it lies within 1 cm (else it is unlabelled), each face the majority of its verti
 without a majority). The nearest *surface point* is used rather than the nearest clean *vertex*:
 clean meshes have 3-5 cm triangles, so almost no new vertex would be within 1 cm of a clean vertex.
 Parts left without vertices or faces are dropped from the GT (listed in ``synth_meta.json``).
+
+Tessellation variants (``decimate``: quadric decimation to a share of the faces; ``cluster_vertices``:
+vertex clustering on a voxel grid, the coarse remesh scanner apps export) re-make a finished scan mesh the
+way a user's mesh may come: the same surface in other triangles. Perception must give the same answer on
+them; ``benchmarks/make_variants.py`` writes them as scene folders, and ``generate_scene(decimate=...)``
+decimates a laser / TSDF scene's mesh before its ground truth is transferred.
 """
 
 from __future__ import annotations
@@ -139,6 +145,43 @@ def decimate(mesh: TriMesh, reduction: float) -> TriMesh:
 
     v, f = fast_simplification.simplify(mesh.vertices.astype(np.float32), mesh.faces.astype(np.int32), reduction)
     return canonical_mesh(np.asarray(v, np.float64), np.asarray(f, np.int64))
+
+
+def decimate_to(mesh: TriMesh, keep: float) -> TriMesh:
+    """Quadric decimation keeping ``keep`` of the faces (0 < keep <= 1) or, with ``keep`` > 1, about
+    that many faces; colours taken from the nearest point of the input surface."""
+    if keep <= 0:
+        raise ValueError(f"decimation must keep a positive share or count of faces, got {keep}")
+    share = keep if keep <= 1 else min(1.0, keep / max(mesh.n_faces, 1))
+    if share >= 1:
+        return mesh
+    return recoloured(mesh, decimate(mesh, 1.0 - share))
+
+
+def cluster_vertices(mesh: TriMesh, voxel: float) -> TriMesh:
+    """Vertex clustering on a ``voxel`` grid (Open3D, vertices averaged per cell; faces that collapse
+    dropped), colours from the nearest point of the input surface."""
+    import open3d as o3d
+
+    if voxel <= 0:
+        raise ValueError(f"clustering voxel must be positive, got {voxel}")
+    m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(mesh.vertices.astype(np.float64)),
+                                  o3d.utility.Vector3iVector(mesh.faces.astype(np.int32)))
+    c = m.simplify_vertex_clustering(voxel_size=float(voxel))
+    out = canonical_mesh(np.asarray(c.vertices, np.float64), np.asarray(c.triangles, np.int64))
+    return recoloured(mesh, out)
+
+
+def recoloured(src: TriMesh, dst: TriMesh) -> TriMesh:
+    """``dst`` with each vertex coloured like the nearest point of ``src``'s surface (``dst`` as is when
+    ``src`` has no colours)."""
+    if src.colors is None or dst.n_vertices == 0:
+        return dst
+    points, prim, uv = Rasterizer(src).closest_points(dst.vertices.astype(np.float32))
+    tri = src.faces[prim]
+    cs = src.colors.astype(np.float64)
+    col = cs[tri[:, 0]] * (1 - uv[:, :1] - uv[:, 1:]) + cs[tri[:, 1]] * uv[:, :1] + cs[tri[:, 2]] * uv[:, 1:]
+    return TriMesh(dst.vertices, dst.faces, np.clip(np.round(col), 0, 255).astype(np.uint8))
 
 
 def laser_depth(z_depth: np.ndarray, ray_dirs_cam_norm: np.ndarray, rng: np.random.Generator,

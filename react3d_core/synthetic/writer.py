@@ -29,7 +29,7 @@ from .materials import GLASS, REALISM, GlassLayer, PhotoSettings, render_photo, 
 from .observed import keep_faces, observed_faces
 from .procedural import SynthLayout
 from .remesh import (LASER_DECIMATION, LASER_VOXEL, MESH_KINDS, TRANSFER_RADIUS, TSDF_VOXEL, TsdfFuser, decimate,
-                     laser_depth, transfer_labels, transfer_parts)
+                     decimate_to, laser_depth, transfer_labels, transfer_parts)
 from .render import DEPTH_SIZE, RGB_SIZE, RayCaster, base_intrinsics, scale_K, sensor_depth
 
 # 2: URDF sources keep only observed surfaces; 3: photo realism (default) and laser / TSDF scan meshes;
@@ -86,12 +86,16 @@ def _ray_norm(K: np.ndarray, width: int, height: int) -> np.ndarray:
 
 
 def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: list[GTPart], face_pid: np.ndarray,
-                 meta: list[dict], keep_empty: bool = False) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
-    """The fused scan mesh, the GT moved onto it, the meta rows of the parts kept and mesh statistics.
-    ``keep_empty``: movable parts left without scan surface stay in the GT (they carry their box)."""
+                 meta: list[dict], keep: float = 1.0, keep_empty: bool = False) -> tuple[TriMesh, list[GTPart], list[dict], dict]:
+    """The fused scan mesh (quadric-decimated to ``keep`` of its faces), the GT moved onto it, the meta
+    rows of the parts kept and mesh statistics. ``keep_empty``: movable parts left without scan surface
+    stay in the GT (they carry their box)."""
     new = fuser.mesh()
     if kind == "laser":
         new = decimate(new, LASER_DECIMATION)
+    fused_faces = new.n_faces
+    if keep < 1:
+        new = decimate_to(new, keep)
     tr = transfer_labels(layout.mesh, face_pid, new)
     if kind == "laser":  # a laser scan is coloured from registered photos: the clean colour at the surface
         new = TriMesh(new.vertices, new.faces, tr.colors)
@@ -106,7 +110,7 @@ def _remeshed_gt(layout: SynthLayout, fuser: TsdfFuser, kind: str, gt_parts: lis
                      "handle": r["handle_part_id"] in n_faces,
                      "parent_part_id": r["parent_part_id"] if r["parent_part_id"] in n_faces else None})
     stats = {"kind": kind, "voxel": LASER_VOXEL if kind == "laser" else TSDF_VOXEL,
-             "decimation": LASER_DECIMATION if kind == "laser" else 0.0,
+             "decimation": LASER_DECIMATION if kind == "laser" else 0.0, "kept_share": keep, "fused_faces": fused_faces,
              "clean_faces": layout.mesh.n_faces, "clean_vertices": layout.mesh.n_vertices,
              "transfer_radius": TRANSFER_RADIUS, "labelled_vertices": float((tr.vertex_label >= 0).mean()),
              "median_distance_to_clean": float(np.median(tr.distance)) if len(tr.distance) else None,
@@ -204,11 +208,13 @@ class _SeeThrough:
 def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, seed: int, source: str,
                     scene_id: str | None = None, room_depths: list[float] | None = None, mesh: str = "clean",
                     realism: str = "photo", misregister: tuple[float, float] = (0.0, 0.0),
-                    depth_dropout: str = "none") -> Path:
+                    depth_dropout: str = "none", decimate: float = 1.0) -> Path:
     """Render ``n_frames`` views of ``layout`` and write the scene folder; returns ``out_dir``.
 
     ``mesh``: the written scan mesh, ``clean`` (the generated geometry), ``laser`` or ``tsdf`` (re-made
-    like a real scan, GT transferred; see :mod:`.remesh`). ``realism``: ``photo`` (materials, lights,
+    like a real scan, GT transferred; see :mod:`.remesh`); ``decimate``: share of that laser / TSDF
+    mesh's faces kept by quadric decimation before the GT is transferred (1: as made; a user's exported
+    scan is often decimated). ``realism``: ``photo`` (materials, lights,
     exposure, blur; :mod:`.materials`) or ``plain`` (flat shading, the generator-version-2 images).
     ``misregister``: colour shifted by (dx, dy) RGB pixels against depth and poses (photo only).
     ``depth_dropout``: ``dark`` drops depth on dark and glossy surfaces like a ToF sensor, in the depth
@@ -224,6 +230,10 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
         raise ValueError(f"unknown mesh {mesh!r}; choose from {', '.join(MESH_KINDS)}")
     if realism not in REALISM:
         raise ValueError(f"unknown realism {realism!r}; choose from {', '.join(REALISM)}")
+    if not 0 < decimate <= 1:
+        raise ValueError(f"decimate is the share of faces kept, in (0, 1]; got {decimate}")
+    if decimate < 1 and mesh == "clean":
+        raise ValueError("decimate needs mesh='laser' or 'tsdf' (the clean mesh's ground truth is its own faces)")
     if depth_dropout not in DEPTH_DROPOUT:
         raise ValueError(f"unknown depth_dropout {depth_dropout!r}; choose from {', '.join(DEPTH_DROPOUT)}")
     misregister = (float(misregister[0]), float(misregister[1]))
@@ -303,7 +313,8 @@ def write_synthetic(layout: SynthLayout, out_dir: str | Path, n_frames: int, see
             scan, _ = layout.mesh.submesh(keep)
             mesh_stats = {"kind": "clean", "glass_faces_left_out": int(glass.sum())}
         if fuser is not None:
-            scan, gt_parts, meta, mesh_stats = _remeshed_gt(layout, fuser, mesh, gt_parts, face_pid, meta, keep_empty=with_boxes)
+            scan, gt_parts, meta, mesh_stats = _remeshed_gt(layout, fuser, mesh, gt_parts, face_pid, meta, decimate,
+                                                           keep_empty=with_boxes)
         if with_boxes:
             boxes = _boxes_and_coverage(layout, face_pid, gt_parts, scan if fuser is not None else None, seen, glass)
             for p in gt_parts:

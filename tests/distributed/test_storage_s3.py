@@ -1,6 +1,6 @@
 """The shared store on a real S3-compatible server (s3rver keeps objects on disk): two workers with their
-own mirrors share objects and sealed folders, outputs publish to s3:// with the manifest last, and a
-prefix holding someone else's files is refused. Fast (~5 s); skipped where s3rver is not installed."""
+own mirrors share objects and sealed folders, outputs publish to s3:// under a fresh prefix with their
+pointer last, and a prefix holding someone else's files is refused. Fast (~5 s); skipped where s3rver is not installed."""
 
 from __future__ import annotations
 
@@ -66,7 +66,7 @@ def test_objects_and_sealed_folders_reach_a_second_worker(remote: str, tmp_path:
         store.get(h)
 
 
-def test_publish_tree_uploads_manifest_last_and_refuses_foreign_prefixes(remote: str, tmp_path: Path) -> None:
+def test_publish_tree_writes_a_fresh_prefix_and_its_pointer_and_refuses_foreign_prefixes(remote: str, tmp_path: Path) -> None:
     from react3d_core.atomic import OUTPUT_MARKER
     from react3d_core.errors import InputError
     from tasks import storage
@@ -78,12 +78,21 @@ def test_publish_tree_uploads_manifest_last_and_refuses_foreign_prefixes(remote:
     (local / "scene.json").write_text(json.dumps({"objects": [1, 2], "input_mesh": "../scan.ply"}))
     url = f"{remote}/out/s0"
     manifest = storage.publish_tree(local, url)
+    assert manifest == storage.output_manifest(url)
     assert json.loads(storage.read_text(manifest))["input_mesh"] == str((tmp_path / "scan.ply").resolve())
+    first = storage.read_pointer(url)["prefix"]
     (local / "meshes" / "a.ply").unlink()
     (local / "meshes" / "b.ply").write_bytes(b"b")
-    storage.publish_tree(local, url)  # a rerun replaces the old output: a.ply is gone
+    storage.publish_tree(local, url)  # a rerun goes to a fresh prefix; the previous one stays for its readers
+    second = storage.read_pointer(url)["prefix"]
+    storage.publish_tree(local, url)  # the one before the previous is removed
+    third = storage.read_pointer(url)["prefix"]
     fs, path = storage.filesystem(url)
-    assert sorted(p[len(path) + 1:] for p in fs.find(path)) == [OUTPUT_MARKER, "meshes/b.ply", "scene.json"]
+    assert len({first, second, third}) == 3
+    files = [OUTPUT_MARKER, "meshes/b.ply", "scene.json"]
+    assert sorted(p[len(path) + 1:] for p in fs.find(path)) == sorted(
+        [OUTPUT_MARKER, storage.OUTPUT_POINTER] + [f"{v}/{f}" for v in (second, third) for f in files])
+    assert sorted(storage.read_pointer(url)["files"]) == files
 
     fs.pipe_file(f"{storage.filesystem(remote)[1]}/theirs/data.csv", b"1,2")
     with pytest.raises(InputError, match="did not write"):

@@ -4,8 +4,9 @@ process pool with two `prefect worker` processes, the convert-scene deployment, 
 1. Both workers run scenes (flow-run labels), the table artifact lists all four; one worker is killed
    (SIGKILL of its process tree, by PID) during a scene: the run is marked Crashed (heartbeat automation),
    resubmitted, and finishes on the other worker with its finished tasks read from the cache.
-2. The same dataset with the store and the outputs on an S3-compatible server (s3rver, objects on disk)
-   gives the same manifests as the shared-folder run; a bad-input scene fails once, with its reason.
+2. The same dataset with the scans, the store and the outputs on an S3-compatible server (s3rver,
+   objects on disk) gives the same manifests as the shared-folder run; a bad-input scene fails once,
+   with its reason.
 3. A scene's process killed under a living worker (the OOM case) is Crashed at once and retried.
 
 Run: python -m pytest -m slow tests/distributed/test_two_workers.py -v
@@ -87,12 +88,15 @@ def test_two_workers_share_the_dataset_and_a_killed_worker_costs_one_retry(datas
 
 def _normalized_manifest(path: str | Path, text: str) -> dict[str, Any]:
     """A manifest without what differs between any two runs (timings, creation time) and with the scan
-    mesh as one absolute path (a local output names it relative to its folder, an s3:// one absolutely)."""
+    mesh as its path inside the scan (a local output names it relative to its folder, an s3:// one absolutely)."""
     m = json.loads(text)
     m.pop("timings", None)
     m.pop("created", None)
+    if isinstance(m.get("physics"), dict):  # the physics check's record carries its time too
+        m["physics"].pop("created", None)
     mesh = Path(m["input_mesh"])
-    m["input_mesh"] = str(mesh if mesh.is_absolute() else (Path(path).parent / mesh).resolve())
+    # where the scan was read from differs (the dataset folder, a worker's scan cache); the file in it does not
+    m["input_mesh"] = "/".join((mesh if mesh.is_absolute() else (Path(path).parent / mesh).resolve()).parts[-2:])
     return m
 
 
@@ -118,9 +122,19 @@ def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Pat
     (bad / "broken" / "scans").mkdir(parents=True)
     (bad / "broken" / "scans" / "mesh_aligned_0.05.ply").write_bytes(b"not a mesh")
     with S3Server(tmp_path / "s3" / "data") as s3:
-        store, out = s3.url("store"), s3.url("out")
+        store, out, scans = s3.url("store"), s3.url("out"), s3.url("scans")
+        import os
+
+        os.environ.update(s3.env)
+        try:  # the scans are read from the bucket: each worker downloads its scenes into its scan cache
+            fs, path = storage.filesystem(scans)
+            fs.pipe({f"{path}/{name}/{q.relative_to(bad / name).as_posix()}": q.read_bytes()
+                     for name in (*SCENES, "broken") for q in (bad / name).rglob("*") if q.is_file()})
+        finally:
+            for k in s3.env:
+                os.environ.pop(k, None)
         with LocalCluster(tmp_path / "cluster", n_workers=2, store=store, extra_env=s3.env) as c:
-            r = c.convert_dataset([str(bad), "--out", out, *ARGS])
+            r = c.convert_dataset([scans, "--out", out, *ARGS])
             runs = c.scene_runs()
             rows = _rows(c)
         assert r.returncode == 1, r.stdout + r.stderr  # one scene failed
@@ -133,16 +147,18 @@ def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Pat
             for name in SCENES:
                 assert rows[name]["status"] == "ok", rows
                 local = _RESULTS["local"] / name / "scene.json"
-                remote = f"{out}/{name}/scene.json"
+                remote = storage.output_manifest(f"{out}/{name}")  # through its pointer
                 a, b = _normalized_manifest(remote, storage.read_text(remote)), _normalized_manifest(local, local.read_text())
                 assert a == b, f"{name}: manifests differ at {_diff_paths(a, b)[:10]}"
-                fs, path = storage.filesystem(f"{out}/{name}")
+                assert sorted(storage.read_pointer(f"{out}/{name}")["files"]) == sorted(  # names, sizes checked
+                    p.relative_to(local.parent).as_posix() for p in local.parent.rglob("*") if p.is_file())
+                fs, path = storage.filesystem(remote.rsplit("/", 1)[0])
                 remote_files = {p[len(path) + 1:]: hashlib.sha256(fs.cat_file(p)).hexdigest() for p in fs.find(path)}
                 local_files = {p.relative_to(local.parent).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
                                for p in local.parent.rglob("*") if p.is_file()}
                 same = {k for k in local_files if remote_files.get(k) == local_files[k]}
-                # meshes, URDF, metrics: byte-identical; the manifest, report and marker carry times
-                assert set(local_files) - same <= {"scene.json", "report.html", ".react3d-output"}, name
+                # meshes, URDF, metrics: byte-identical; the manifest, report, marker and physics record carry times
+                assert set(local_files) - same <= {"scene.json", "report.html", ".react3d-output", "physics_check.json"}, name
                 assert set(remote_files) == set(local_files), name
         finally:
             for k in s3.env:

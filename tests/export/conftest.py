@@ -1,7 +1,8 @@
 """A hand-made interactive scene: floor + wall background, a cabinet with a revolute door and a
 cabinet with a drawer (front + inner box), vertex-coloured, written with react3d_core.data.
 
-Geometry (metres, z up, the room is at y < 0.5, cabinets stand against the wall at y = 1):
+Geometry (metres, z up, the room is at y < 0.5, cabinets stand against the wall at y = 1; the
+background also holds the door cabinet's scanned top at z = 0.61):
 - door cabinet x in [-1, -0.5], drawer cabinet x in [0, 0.6]; both open at y = 0.5;
 - door: a scanned-like open sheet at y = 0.48 with a handle box, hinge at x = -0.99, axis -z
   (q > 0 swings it out into the room), limits [0, pi/2];
@@ -78,7 +79,9 @@ def build_scene(out: Path) -> Path:
     meshes = out / "meshes"
     floor = grid(np.array([-2.0, -2.0, 0.0]), np.array([4.0, 0, 0]), np.array([0, 3.0, 0]), 12)
     wall = grid(np.array([-2.0, 1.0, 0.0]), np.array([0, 0, 2.5]), np.array([4.0, 0, 0]), 8)
-    save_mesh(meshes / "background.ply", _mesh([floor, wall]))
+    # the scan also holds the door cabinet's top, inside its carcass: no longer a collider once the carcass stands there
+    top = grid(np.array([-0.98, 0.52, 0.61]), np.array([0.46, 0, 0]), np.array([0, 0.46, 0]), 2)
+    save_mesh(meshes / "background.ply", _mesh([floor, wall, top]))
 
     door_sheet = grid(np.array([-0.99, 0.48, 0.03]), np.array([0.48, 0, 0]), np.array([0, 0, 0.58]), 6)
     handle = box((-0.6, 0.45, 0.30), (-0.56, 0.47, 0.40))

@@ -28,9 +28,9 @@ def test_manifest_records_exports(exported: dict[str, Path]) -> None:
     urdf_dir = exported["urdf"].parent
     assets = root / "export" / "assets"
     assert (urdf_dir / "display.launch.py").is_file() and (urdf_dir / "display.launch").is_file()
-    assert (assets / "drawer__part" / "visual_0.glb").is_file()
+    assert (assets / "drawer" / "visual_0.glb").is_file()
     # one folder per visual: trimesh's fixed MTL/PNG names never collide
-    for link in ("background", "door__base", "door__part", "drawer__base", "drawer__part"):
+    for link in ("background", "door_base", "door", "drawer_base", "drawer"):
         assert (assets / link / "visual_0" / "material_0.png").is_file()
     # every mesh and texture is written once, in the shared assets: the format folders hold none
     for fmt in ("urdf", "mjcf", "usd"):
@@ -83,7 +83,8 @@ def test_moved_export_folder_still_loads(exported: dict[str, Path], tmp_path: Pa
         body = pb.loadURDF(str(urdf), useFixedBase=True, physicsClientId=cid)
         shapes = [pb.getCollisionShapeData(body, j, physicsClientId=cid) for j in range(pb.getNumJoints(body, physicsClientId=cid))]
         assert all(len(s) > 0 for s in shapes)
-        assert all(str(moved).encode() in s[0][4] for s in shapes)
+        files = [sh[4] for s in shapes for sh in s if sh[2] == pb.GEOM_MESH]  # background patches are boxes, no files
+        assert files and all(str(moved).encode() in f for f in files)
     finally:
         pb.disconnect(cid)
     model = mujoco.MjModel.from_xml_path(str(moved / "mjcf" / "scene.xml"))
@@ -145,7 +146,7 @@ def test_cell_atlas_path_loads_in_simulators(scene_dir: Path, tmp_path: Path) ->
     out = export_scene(d, formats=("urdf", "mjcf"), config=ExportConfig(xatlas_max_faces=1, texel_per_m=50, write_glb=False))
     obj = out["urdf"].parents[1] / "assets" / "background" / "visual_0" / "mesh.obj"
     text = obj.read_text()
-    assert text.count("\nv ") == 13 * 13 + 9 * 9 and " 1/" in text  # scan positions once, UVs per corner
+    assert text.count("\nv ") == 13 * 13 + 9 * 9 + 3 * 3 and " 1/" in text  # scan positions once (floor, wall, cabinet top), UVs per corner
     model = mujoco.MjModel.from_xml_path(str(out["mjcf"]))
     assert model.ntex >= 5
     cid = pb.connect(pb.DIRECT)
@@ -194,7 +195,7 @@ def test_jpeg_textures_load_in_all_simulators(scene_dir: Path, tmp_path: Path) -
     d = tmp_path / "scene"
     shutil.copytree(scene_dir, d)
     out = export_scene(d, config=ExportConfig(texel_per_m=100, texture_format="jpg", write_glb=False))
-    tex = d / "export" / "assets" / "door__part" / "visual_0"
+    tex = d / "export" / "assets" / "door" / "visual_0"
     assert (tex / "material_0.jpg").is_file() and (tex / "material_0.png").is_file()
     assert "map_Kd material_0.jpg" in (tex / "material.mtl").read_text()
     assert mujoco.MjModel.from_xml_path(str(out["mjcf"])).ntex >= 5

@@ -94,7 +94,7 @@ def test_physx_loads_one_articulation_per_object_with_limits(physx_scene, export
         assert roots.shape[0] == 1
         lim = _read(physx_scene, f"/World/{obj.object_id}", TensorType.ARTICULATION_DOF_LIMIT).reshape(-1)
         np.testing.assert_allclose(lim, [obj.articulation.lower, obj.articulation.upper], atol=1e-4)
-        pose = _read(physx_scene, f"/World/{obj.object_id}/part", TensorType.RIGID_BODY_POSE).reshape(-1)
+        pose = _read(physx_scene, f"/World/{obj.object_id}/{obj.object_id}", TensorType.RIGID_BODY_POSE).reshape(-1)
         np.testing.assert_allclose(pose[:3], obj.articulation.origin, atol=1e-5)  # nothing moved at load
 
 
@@ -112,7 +112,7 @@ def test_physx_drives_each_joint_to_its_limit(physx_scene, exported: dict[str, P
             physx_scene.wait_all()
         q = float(_read(physx_scene, pat, TensorType.ARTICULATION_DOF_POSITION).reshape(-1)[0])
         assert q == pytest.approx(art.upper, abs=0.02 * max(art.upper, 1.0))  # pushed open, stopped at the limit
-        pose = _read(physx_scene, f"{pat}/part", TensorType.RIGID_BODY_POSE).reshape(-1)
+        pose = _read(physx_scene, f"{pat}/{obj.object_id}", TensorType.RIGID_BODY_POSE).reshape(-1)
         assert part_error(pose, load_mesh(root / obj.part_mesh).vertices, art, q) <= 5e-3
         _write(physx_scene, pat, TensorType.ARTICULATION_DOF_ACTUATION_FORCE, np.array([0.0]))
 
@@ -150,6 +150,6 @@ def test_isaac_urdf_importer_output_loads_in_physx_with_same_joints(exported: di
             physx.step(1 / 60)
             physx.wait_all()
         for obj in scene.objects:
-            pose = _read(physx, prims[f"{obj.object_id}__part"], TensorType.RIGID_BODY_POSE).reshape(-1)
+            pose = _read(physx, prims[obj.object_id], TensorType.RIGID_BODY_POSE).reshape(-1)
             art = obj.articulation
             assert part_error(pose, load_mesh(root / obj.part_mesh).vertices, art, art.upper) <= 5e-3

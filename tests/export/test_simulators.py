@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 from react3d_core.data import InteractiveScene, load_mesh
 
 
-JOINTS = {"door": "door__joint", "drawer": "drawer__joint"}
+JOINTS = {"door": "door_joint", "drawer": "drawer_joint"}
 
 
 def half_limit(art) -> float:  # noqa: ANN001
@@ -64,7 +64,7 @@ def test_pybullet_joint_motion_matches_articulation(exported: dict[str, Path]) -
             j = names[JOINTS[obj.object_id]]
             info = pb.getJointInfo(body, j, physicsClientId=cid)
             assert (info[8], info[9]) == pytest.approx((obj.articulation.lower, obj.articulation.upper))
-            local = local_vertices(urdf_visual_obj(exported["urdf"], f"{obj.object_id}__part"))
+            local = local_vertices(urdf_visual_obj(exported["urdf"], obj.object_id))
             pb.resetJointState(body, j, 0.0, physicsClientId=cid)
             closed = apply(pb_pose(pb, cid, body, j), local)
             # at q = 0 the exported part sits exactly on the scanned part
@@ -95,7 +95,7 @@ def test_pybullet_gravity_rollout_keeps_closed_parts_still(exported: dict[str, P
         for k, j in parts.items():
             T = pb_pose(pb, cid, body, j)
             assert np.all(np.isfinite(T))
-            local = local_vertices(urdf_visual_obj(exported["urdf"], f"{k}__part"))
+            local = local_vertices(urdf_visual_obj(exported["urdf"], k))
             disp = np.linalg.norm(apply(T, local) - apply(start[k], local), axis=1).max()
             assert disp <= 0.01, (k, disp)
     finally:
@@ -115,7 +115,7 @@ def test_pybullet_ball_rests_inside_open_drawer(exported: dict[str, Path]) -> No
     pb, cid, body, names = pybullet_body(exported["urdf"])
     try:
         pb.setGravity(0, 0, -9.81, physicsClientId=cid)
-        j = names["drawer__joint"]
+        j = names["drawer_joint"]
         pb.resetJointState(body, j, 0.3, physicsClientId=cid)
         pb.setJointMotorControl2(body, j, pb.POSITION_CONTROL, targetPosition=0.3, force=500, physicsClientId=cid)
         shape = pb.createCollisionShape(pb.GEOM_SPHERE, radius=0.03, physicsClientId=cid)
@@ -142,7 +142,7 @@ def test_yourdfpy_fk_agrees_with_pybullet(exported: dict[str, Path]) -> None:
         for name, q in cfg.items():
             pb.resetJointState(body, names[name], q, physicsClientId=cid)
         for o in scene.objects:
-            T_y = robot.get_transform(frame_to=f"{o.object_id}__part", frame_from="world")
+            T_y = robot.get_transform(frame_to=o.object_id, frame_from="world")
             T_p = pb_pose(pb, cid, body, names[JOINTS[o.object_id]])
             np.testing.assert_allclose(T_y, T_p, atol=1e-6)
     finally:
@@ -173,15 +173,15 @@ def test_mujoco_compiles_and_moves_parts(exported: dict[str, Path]) -> None:
         assert jid >= 0
         np.testing.assert_allclose(model.jnt_range[jid], [art.lower, art.upper])
         assert model.jnt_type[jid] == (mujoco.mjtJoint.mjJNT_HINGE if art.joint_type == "revolute" else mujoco.mjtJoint.mjJNT_SLIDE)
-        local = local_vertices(mjcf_obj(exported["mjcf"], f"{obj.object_id}__part"))
+        local = local_vertices(mjcf_obj(exported["mjcf"], obj.object_id))
         data.qpos[:] = 0
         mujoco.mj_kinematics(model, data)
-        closed = apply(mj_part_pose(mujoco, model, data, f"{obj.object_id}__part"), local)
+        closed = apply(mj_part_pose(mujoco, model, data, obj.object_id), local)
         assert cKDTree(load_mesh(root / obj.part_mesh).vertices).query(closed)[0].max() <= 1e-6
         q = half_limit(art)
         data.qpos[model.jnt_qposadr[jid]] = q
         mujoco.mj_kinematics(model, data)
-        moved = apply(mj_part_pose(mujoco, model, data, f"{obj.object_id}__part"), local)
+        moved = apply(mj_part_pose(mujoco, model, data, obj.object_id), local)
         assert np.linalg.norm(moved - art.move(closed, q), axis=1).max() <= 1e-3
     # the URDF carries the <mujoco> compiler block, so MuJoCo imports it too
     urdf_model = mujoco.MjModel.from_xml_path(str(exported["urdf"]))
@@ -192,7 +192,7 @@ def test_mujoco_rollout_and_ball_in_drawer(exported: dict[str, Path], tmp_path: 
     mujoco = pytest.importorskip("mujoco")
     model = mujoco.MjModel.from_xml_path(str(exported["mjcf"]))
     data = mujoco.MjData(model)
-    names = [f"{k}__part" for k in JOINTS]
+    names = list(JOINTS)
     mujoco.mj_forward(model, data)
     start = {n: mj_part_pose(mujoco, model, data, n) for n in names}
     for _ in range(1000):  # 2 s
@@ -216,7 +216,7 @@ def test_mujoco_rollout_and_ball_in_drawer(exported: dict[str, Path], tmp_path: 
     finally:
         ball_xml.unlink()
     data = mujoco.MjData(model)
-    jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "drawer__joint")
+    jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, "drawer_joint")
     data.qpos[model.jnt_qposadr[jid]] = 0.3
     for _ in range(1000):
         mujoco.mj_step(model, data)

@@ -60,16 +60,16 @@ def test_synthetic_kitchen_exports_and_moves(synthetic_scene, tmp_path: Path) ->
             pts = load_mesh(manifest.parent / obj.part_mesh).vertices
             local = pts - np.asarray(art.origin)  # the part link sits at the joint origin
             q = 0.5 * art.upper
-            j = idx[f"{obj.object_id}__joint"]
+            j = idx[f"{obj.object_id}_joint"]
             pb.resetJointState(body, j, q, physicsClientId=cid)
             s = pb.getLinkState(body, j, computeForwardKinematics=True, physicsClientId=cid)
             got = local @ Rotation.from_quat(s[5]).as_matrix().T + np.asarray(s[4])
             assert np.linalg.norm(got - art.move(pts, q), axis=1).max() <= 1e-3
-            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{obj.object_id}__joint")
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, f"{obj.object_id}_joint")
             data.qpos[:] = 0
             data.qpos[model.jnt_qposadr[jid]] = q
             mujoco.mj_kinematics(model, data)
-            b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, f"{obj.object_id}__part")
+            b = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, obj.object_id)
             got = local @ data.xmat[b].reshape(3, 3).T + data.xpos[b]
             assert np.linalg.norm(got - art.move(pts, q), axis=1).max() <= 1e-3
     finally:
@@ -82,5 +82,5 @@ def test_synthetic_kitchen_exports_and_moves(synthetic_scene, tmp_path: Path) ->
     assert check_usd(out["usd"]) == []
     stage = Usd.Stage.Open(str(out["usd"]))
     for obj in scene.objects:
-        _, axis = joint_axis_world(stage, stage.GetPrimAtPath(f"/World/{obj.object_id}/joint"))
+        _, axis = joint_axis_world(stage, stage.GetPrimAtPath(f"/World/{obj.object_id}/{obj.object_id}_joint"))
         np.testing.assert_allclose(axis, obj.articulation.axis, atol=1e-5)

@@ -46,7 +46,7 @@ def test_usd_joint_world_axis_and_limits_match_articulation(exported: dict[str, 
     scene = InteractiveScene.load(exported["urdf"].parents[2] / "scene.json")
     stage = Usd.Stage.Open(str(exported["usd"]))
     for obj in scene.objects:
-        prim = stage.GetPrimAtPath(f"/World/{obj.object_id}/joint")
+        prim = stage.GetPrimAtPath(f"/World/{obj.object_id}/{obj.object_id}_joint")
         art = obj.articulation
         origin, axis = joint_axis_world(stage, prim)
         np.testing.assert_allclose(axis, art.axis, atol=1e-5)
@@ -68,10 +68,10 @@ def test_check_usd_catches_misaligned_frames_and_triangle_colliders(exported: di
     d = tmp_path / "usd"
     shutil.copytree(exported["usd"].parent, d)
     stage = Usd.Stage.Open(str(d / "scene.usda"))
-    UsdPhysics.Joint(stage.GetPrimAtPath("/World/door/joint")).GetLocalPos1Attr().Set(Gf.Vec3f(0.1, 0, 0))
-    piece = stage.GetPrimAtPath("/World/drawer/part/collisions/piece_0")
+    UsdPhysics.Joint(stage.GetPrimAtPath("/World/door/door_joint")).GetLocalPos1Attr().Set(Gf.Vec3f(0.1, 0, 0))
+    piece = stage.GetPrimAtPath("/World/drawer/drawer/collisions/piece_0")
     UsdPhysics.MeshCollisionAPI(piece).GetApproximationAttr().Set("none")
-    UsdPhysics.MassAPI(stage.GetPrimAtPath("/World/drawer/part")).GetMassAttr().Set(0.0)
+    UsdPhysics.MassAPI(stage.GetPrimAtPath("/World/drawer/drawer")).GetMassAttr().Set(0.0)
     stage.GetRootLayer().Save()
     problems = check_usd(d / "scene.usda")
     assert any("frame origins differ" in p for p in problems)
@@ -85,14 +85,23 @@ def test_usd_visuals_keep_scan_topology_with_face_varying_uvs(exported: dict[str
     from react3d_core.data import load_mesh
 
     stage = Usd.Stage.Open(str(exported["usd"]))
-    mesh = UsdGeom.Mesh(stage.GetPrimAtPath("/World/background/background_visual_0"))
     scan = load_mesh(scene_dir / "meshes" / "background.ply")
-    points = np.asarray(mesh.GetPointsAttr().Get())
-    assert len(points) == scan.n_vertices
-    assert len(mesh.GetFaceVertexIndicesAttr().Get()) == 3 * scan.n_faces
-    st = UsdGeom.PrimvarsAPI(mesh).GetPrimvar("st")
-    assert st.GetInterpolation() == UsdGeom.Tokens.faceVarying
-    assert len(st.Get()) == 3 * scan.n_faces
+    # the scan is written once, split into the faces that collide and those in a part's path or a carcass
+    prims = [stage.GetPrimAtPath(f"/World/background/background_visual_0{s}") for s in ("", "_visual_only")]
+    assert all(p.IsValid() for p in prims)
+    corners, n_points = [], 0
+    for prim in prims:
+        mesh = UsdGeom.Mesh(prim)
+        points = np.asarray(mesh.GetPointsAttr().Get())
+        idx = np.asarray(mesh.GetFaceVertexIndicesAttr().Get()).reshape(-1, 3)
+        assert len(np.unique(idx)) == len(points)  # shared points (scan topology), none unused
+        st = UsdGeom.PrimvarsAPI(mesh).GetPrimvar("st")
+        assert st.GetInterpolation() == UsdGeom.Tokens.faceVarying
+        assert len(st.Get()) == idx.size
+        corners.append(points[idx])
+        n_points += len(points)
+    assert n_points <= scan.n_vertices + 200  # only vertices on the cut between the two are written twice
+    tri = np.concatenate(corners)
+    assert len(tri) == scan.n_faces
     # same triangles as the scan (as point sets)
-    idx = np.asarray(mesh.GetFaceVertexIndicesAttr().Get()).reshape(-1, 3)
-    np.testing.assert_allclose(np.sort(points[idx].sum(1), axis=0), np.sort(scan.vertices[scan.faces].sum(1), axis=0), atol=1e-5)
+    np.testing.assert_allclose(np.sort(tri.sum(1), axis=0), np.sort(scan.vertices[scan.faces].sum(1), axis=0), atol=1e-5)

@@ -8,10 +8,12 @@ Geometry (metres, z up; the room is at y < 0.5, the cabinets stand against a wal
 - drawer cabinet x in [0, 0.6], z in [0.02, 0.32]; the drawer front y in [0.47, 0.49] with an open-top
   inner box x in [0.04, 0.56], y in [0.49, 0.95], z in [0.06, 0.26] (1 cm walls), axis -y, limits [0, 0.4].
 
-``overlapping``: the same scene with a background block through the closed door (x in [-0.9, -0.8],
-y in [0.40, 0.55], z in [0.25, 0.45]) and one in the middle of the door's cavity (x in [-0.8, -0.7],
-y in [0.65, 0.8], z in [0.25, 0.4]): scanned geometry left in the background, as the carving leaves it
-when it misses. The drawer is untouched (its joint must still pass).
+``overlapping``: the clean export with two background colliders added to the written URDF and MJCF, a
+block through the closed door (x in [-0.9, -0.8], y in [0.40, 0.55], z in [0.25, 0.45]) and one in the
+middle of the door's cavity (x in [-0.8, -0.7], y in [0.65, 0.8], z in [0.25, 0.4]): scanned geometry
+left in the background, as it stays when the exporter's carving misses (the exporter itself carves such
+blocks out of a scanned background, so they are added after it). The drawer is untouched (its joint must
+still pass).
 """
 
 from __future__ import annotations
@@ -62,15 +64,17 @@ def mesh(parts: list[trimesh.Trimesh], grey: int = 160, max_edge: float | None =
     return TriMesh(v, f, np.full((len(v), 3), grey, np.uint8))
 
 
-def build_scene(out: Path, overlapping: bool = False, door_front: bool = True) -> Path:
+LEFT_IN_BACKGROUND = [((-0.9, 0.40, 0.25), (-0.8, 0.55, 0.45)), ((-0.8, 0.65, 0.25), (-0.7, 0.8, 0.4))]
+"""(lo, hi) of the blocks ``overlapping`` leaves in the background: through the closed door, in its cavity."""
+
+
+def build_scene(out: Path, door_front: bool = True) -> Path:
     """Write the scene's manifest and meshes under ``out``; returns the manifest path.
 
     ``door_front=False`` leaves only the door's handle in its part mesh (the front plate is missing: a
     probe thrown at the front must get through)."""
     meshes = out / "meshes"
     bg = [box((-2.0, -2.0, -0.05), (2.0, 1.0, 0.0)), box((-2.0, 1.0, -0.05), (2.0, 1.05, 2.0))]
-    if overlapping:
-        bg += [box((-0.9, 0.40, 0.25), (-0.8, 0.55, 0.45)), box((-0.8, 0.65, 0.25), (-0.7, 0.8, 0.4))]
     save_mesh(meshes / "background.ply", mesh(bg, 120, max_edge=0.1))
     handle = box((-0.6, 0.44, 0.30), (-0.56, 0.47, 0.40))
     door = [box((-0.99, 0.47, 0.03), (-0.51, 0.49, 0.61)), handle] if door_front else [handle]
@@ -98,9 +102,30 @@ def build_scene(out: Path, overlapping: bool = False, door_front: bool = True) -
     return scene.save(out / "scene.json")
 
 
-def export(out: Path, **kw: bool) -> Path:
+def export(out: Path, overlapping: bool = False, **kw: bool) -> Path:
     from react3d_core.export import export_scene
 
     build_scene(out, **kw)
     export_scene(out / "scene.json", config=FAST)
+    if overlapping:
+        leave_in_background(out, LEFT_IN_BACKGROUND)
     return out
+
+
+def leave_in_background(out: Path, boxes: list[tuple[tuple[float, float, float], tuple[float, float, float]]]) -> None:
+    """Add axis-aligned boxes (world lo, hi) to the background's colliders in the written URDF and MJCF
+    (the background's frame is the world's in both)."""
+    urdf, mjcf = out / "export" / "urdf" / "scene.urdf", out / "export" / "mjcf" / "scene.xml"
+    u, m = urdf.read_text(), mjcf.read_text()
+    start = u.index('<link name="background">')
+    end = u.index("</link>", start)
+    col, geoms = "", ""
+    for k, (lo, hi) in enumerate(boxes):
+        c, e = (np.add(lo, hi) / 2).tolist(), np.subtract(hi, lo).tolist()
+        col += (f'    <collision name="left_{k}"><origin xyz="{c[0]} {c[1]} {c[2]}" rpy="0 0 0"/>'
+                f'<geometry><box size="{e[0]} {e[1]} {e[2]}"/></geometry></collision>\n')
+        geoms += f'    <geom name="left_{k}" type="box" pos="{c[0]} {c[1]} {c[2]}" size="{e[0] / 2} {e[1] / 2} {e[2] / 2}" class="collision"/>\n'
+    urdf.write_text(u[:end] + col.lstrip() + "  " + u[end:])
+    anchor = m.index("<worldbody>")
+    anchor = m.index("\n", m.index('<geom name="background_', anchor)) + 1
+    mjcf.write_text(m[:anchor] + geoms + m[anchor:])

@@ -21,7 +21,7 @@ def test_check_writes_json_and_prints_the_table(clean_out: Path, tmp_path: Path,
     out = copy(clean_out, tmp_path / "out")
     assert main(["check", str(out), "--engines", "mujoco", "--strict"]) == 0
     text = capsys.readouterr().out
-    assert "door__joint" in text and "pass" in text and "mujoco" in text
+    assert "door_joint" in text and "pass" in text and "mujoco" in text
     assert "2/2 joints pass" in text and "cavities 2/2 free, fronts 2/2 blocked" in text
     data = json.loads((out / "physics_check.json").read_text())
     assert [e["engine"] for e in data["engines"]] == ["mujoco"]
@@ -67,7 +67,7 @@ def test_report_shows_the_physics_section(clean_out: Path, tmp_path: Path) -> No
     summary = InteractiveScene.load(out / "scene.json").physics
     assert summary["passed"] and summary["engines"]["mujoco"]["passed"] == 2 and summary["file"] == "physics_check.json"
     page = write_report(out / "scene.json", thumbnails=False).read_text()
-    assert "Physics check: pass" in page and "<td>door__joint</td>" in page and "2/2 joints pass" in page
+    assert "Physics check: pass" in page and "<td>door_joint</td>" in page and "2/2 joints pass" in page
     # a check that could not run is said so, and the conversion's manifest still loads
     record_physics(out / "scene.json", None, "RuntimeError: engine exploded")
     page = write_report(out / "scene.json", thumbnails=False).read_text()

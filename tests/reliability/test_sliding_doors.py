@@ -53,7 +53,7 @@ def test_sliding_doors_slide_in_the_front_plane(perception: str, synthetic_scene
         iou = {pid: len(np.intersect1d(ids, s)) / len(np.union1d(ids, s)) for pid, s in gt_sets.items()}
         pid = max(iou, key=iou.get)
         if iou[pid] > 0.5:
-            jt, axis, upper = joints[f"{obj.object_id}__joint"]
+            jt, axis, upper = joints[f"{obj.object_id}_joint"]
             assert jt == "prismatic", by_id[pid].label
             found[pid] = axis
             if pid in sliding:

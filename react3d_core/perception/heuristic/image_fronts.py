@@ -26,6 +26,7 @@ from .fronts import Front, _joint, _neighbours, doors_in_rows
 from .line_evidence import LineSupport, line_support
 from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
 from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
+from .plane_surface import PlaneSurface, cast_surface, flat_surface
 from .planes import Plane, vertical_planes
 
 _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
@@ -76,9 +77,10 @@ def off_the_floor(fronts: list[Front], floor: float | None, gap: float) -> list[
     return [f for f in fronts if f.handle_points is not None or f.extent_v[0] > floor + gap]
 
 
-def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) -> np.ndarray:
+def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) -> np.ndarray:
     """Grid pixels covered by the plane's own faces (centroids splatted, holes up to ``close`` m closed,
-    fragments under ``min_area`` m² dropped)."""
+    fragments under ``min_area`` m² dropped): ``image.surface_rays`` off. Decimated scans' faces lie
+    farther apart than ``close``, so their planes come out mostly uncovered."""
     h, w = o.n_views.shape
     cen = mesh.face_centroids[o.plane.faces]
     c = np.floor((cen @ o.plane.u - o.u0) / o.res).astype(int)
@@ -89,6 +91,18 @@ def coverage_map(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) ->
     k = max(MIN_KERNEL, int(round(close / o.res)) | 1)
     cov = cv2.morphologyEx(cov, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
     cov = cov.astype(np.uint8)
+    # stray fragments (bits of floor or wall that happen to lie in the plane) are not part of it
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(cov, connectivity=CONNECTIVITY)
+    keep = np.zeros(n, bool)
+    keep[1:] = stats[1:, cv2.CC_STAT_AREA] * o.res ** 2 >= min_area
+    return keep[lab]
+
+
+def coverage_map(o: Orthophoto, flat: np.ndarray, min_area: float, close: float) -> np.ndarray:
+    """Grid pixels where the plane is: the scan surface lying flat in its slab (``flat``, from
+    ``plane_surface.flat_surface``), holes up to ``close`` m closed, fragments under ``min_area`` m² dropped."""
+    k = max(MIN_KERNEL, int(round(close / o.res)) | 1)
+    cov = cv2.morphologyEx(flat.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
     # stray fragments (bits of floor or wall that happen to lie in the plane) are not part of it
     n, lab, stats, _ = cv2.connectedComponentsWithStats(cov, connectivity=CONNECTIVITY)
     keep = np.zeros(n, bool)
@@ -152,14 +166,14 @@ def thin_lines(mask: np.ndarray, res: float, min_len: float, max_width: float) -
     return ((long_h & ~thick_v) | (long_v & ~thick_h)).astype(bool)
 
 
-def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray, hc: HandleConfig, win: float,
+def protrusion_from_faces(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray, hc: HandleConfig, win: float,
                    behind: float) -> np.ndarray:
     """Grid pixels under outward-facing faces standing ``hc.protrusion_depth`` in front of the plane
-    (handles in the mesh), splatted by centroid, closed over ``hc.bar_close_px`` and grown by 1 px: the
+    (handles in the mesh), splatted by centroid (``image.surface_rays`` off), closed over ``hc.bar_close_px`` and grown by 1 px: the
     centroids of a bar's faces sit half a face inside its outline, and a 1.5 cm bar at 4 mm must not
     come out 2 px wide.
 
-    With ``win`` > 0 (``protrusion_from_surface``, the default since version 14) they stand ``depth`` in front of the surface
+    With ``win`` > 0 (``protrusion_from_surface``) they stand ``depth`` in front of the surface
     around them instead: the median offset of the faces within ``win`` (``hc.surface_block`` blocks, each its
     faces' median), faces from ``behind`` the plane on. A TSDF wall lies a centimetre or two off its fitted
     plane in places, and its bumps there are no handles."""
@@ -173,6 +187,32 @@ def protrusion_map(o: Orthophoto, centroids: np.ndarray, normals: np.ndarray, hc
     r = np.floor((o.v_top - centroids[cand, 2]) / o.res).astype(int)
     ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
     dn, r, c = dn[cand][ok], r[ok], c[ok]
+    if win > 0:
+        dn = dn - _local_surface(dn, r, c, (h, w), max(1, int(round(block / o.res))), win / block)[r, c]
+    sel = (dn > depth[0]) & (dn < depth[1])
+    out = np.zeros((h, w), np.uint8)
+    out[r[sel], c[sel]] = 1
+    out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((hc.bar_close_px, hc.bar_close_px), np.uint8))
+    return cv2.dilate(out, NEIGHBOURS).astype(bool)
+
+
+def protrusion_map(o: Orthophoto, surf: PlaneSurface, hc: HandleConfig, win: float, behind: float) -> np.ndarray:
+    """Grid pixels whose front-most surface (``surf.front``, facing outwards: ``hc.protrusion_min_cos``)
+    stands ``hc.protrusion_depth`` in front of the plane (handles in the mesh), closed over
+    ``hc.bar_close_px`` and grown by 1 px.
+
+    With ``win`` > 0 (``protrusion_from_surface``, the default) it stands ``depth`` in front of the surface
+    around it instead: the median offset of the surface within ``win`` (``hc.surface_block`` blocks, each
+    its pixels' median), from ``behind`` the plane on. A TSDF wall lies a centimetre or two off its fitted
+    plane in places, and its bumps there are no handles."""
+    h, w = o.n_views.shape
+    depth, block = hc.protrusion_depth, hc.surface_block
+    dn = surf.front
+    with np.errstate(invalid="ignore"):
+        # outward surface that can stand out: against the plane, from depth[0]; against the surface, from behind it
+        cand = (dn > (-behind if win > 0 else depth[0])) & (dn < depth[1]) & (surf.front_cos > hc.protrusion_min_cos)
+    r, c = np.nonzero(cand)
+    dn = dn[r, c].astype(np.float64)
     if win > 0:
         dn = dn - _local_surface(dn, r, c, (h, w), max(1, int(round(block / o.res))), win / block)[r, c]
     sel = (dn > depth[0]) & (dn < depth[1])
@@ -231,18 +271,25 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     supports: list[LineSupport] = []
     if cfg.lines.enabled and detect_lines is not None:
         supports = line_support(orthos, frames, raster, read_rgb, detect_lines, lambda fi: per_view.get(fi, calib), cfg)
-    centroids, normals = mesh.face_centroids, mesh.face_normals
+    centroids = mesh.face_centroids
     fronts: list[Front] = []
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     diffs = []
     for i, o in enumerate(orthos):
-        cov = coverage_map(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
-        o.n_views[~cov] = 0  # where the plane's own faces are not (floor, worktop edge seen at the same depth)
+        if cfg.image.surface_rays:
+            surf = cast_surface(o.grid_points(), o.plane.n, raster, cfg.planes.offset_tol, hc.protrusion_depth[1],
+                                cfg.planes.offset_tol)
+            cov = coverage_map(o, flat_surface(surf.offset, o.res, cfg.planes.slope_win, cfg.planes.angle_tol_deg),
+                               cfg.planes.min_fragment_area, cfg.image.coverage_close)
+        else:
+            cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
+        o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
         diff = off_background(o, hc)
         diffs.append(diff)
         outline = cov_outline(cov, cfg.image.outline_fill_px)  # handle shadows are holes in the plane, not its outline
         win = hc.background_win if hc.protrusion_from_surface else 0.0
-        bars = protrusion_map(o, centroids, normals, hc, win, cfg.planes.offset_tol)
+        bars = (protrusion_map(o, surf, hc, win, cfg.planes.offset_tol) if cfg.image.surface_rays
+                else protrusion_from_faces(o, centroids, mesh.face_normals, hc, win, cfg.planes.offset_tol))
         handles = find_handles(o, cov, cfg, diff, bars & outline, outline)
         shadows: list[Handle] = []
         if hc.shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells

@@ -35,7 +35,7 @@ from .view_registration import register_views
 _NEAR = 0.1  # m: points closer to the camera than this are at or behind it (no projection)
 _WINDOW_STEP = 4  # grid points: a plane's window in a view is found on every this-many-th point, widened by one
 _MIN_SAMPLES = 20  # a view with fewer samples of a plane tells nothing about its exposure there
-_PICK_GRID = 5  # views are scored on this many x this many points of a plane
+_BEST_GRID = 5  # without pick_spread, views are scored on this many x this many points of a plane
 
 
 @dataclass
@@ -58,6 +58,12 @@ class Orthophoto:
         """In-plane (u, z) of pixel centres (cols, rows)."""
         return (self.u0 + (np.asarray(cols, float) + 0.5) * self.res,
                 self.v_top - (np.asarray(rows, float) + 0.5) * self.res)
+
+    def grid_points(self) -> np.ndarray:
+        """World points (H, W, 3) of every pixel centre, on the plane."""
+        h, w = self.n_views.shape
+        cols, rows = np.meshgrid(np.arange(w), np.arange(h))
+        return self.plane.to_world(*self.to_uv(cols, rows))
 
 
 @dataclass
@@ -118,7 +124,7 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
         span = max(p.extent_u[1] - p.extent_u[0], p.extent_v[1] - p.extent_v[0]) + 2 * params.margin
         res = max(params.resolution, span / params.max_side_px)
         grids.append((*_grid(p, res, params.margin), res))
-    picks = _pick_views(planes, frames, [g[0] for g in grids], params.min_cos, params.max_views)
+    picks = _pick_views(planes, frames, [g[0] for g in grids], params)
     register = calibration.enabled and bool(registration.sigmas_px)
     views: list[list[_View]] = [[] for _ in planes]
     images: dict[int, np.ndarray] = {}
@@ -337,19 +343,27 @@ def _away_from_edges(depth: np.ndarray, px: int, jump: float, edge: np.ndarray |
     return ~edge
 
 
-def _pick_views(planes: Sequence[Plane], frames: Sequence[Frame], grids: list[np.ndarray], min_cos: float,
-                max_views: int) -> list[set[int]]:
-    """Per plane, the best ``max_views`` frames, scored on a 5 x 5 sample of the plane (in front of
-    the camera, inside the image) times the cosine between view ray and plane normal."""
+def _pick_views(planes: Sequence[Plane], frames: Sequence[Frame], grids: list[np.ndarray], p: OrthoConfig) -> list[set[int]]:
+    """Per plane, up to ``max_views`` frames chosen for coverage, sharpness and diversity, on a
+    ``pick_samples`` x ``pick_samples`` sample of the plane: each sample wants ``pick_need`` views; a frame is
+    worth the sum, over the samples that still want views and that it sees (in front, inside the image, at
+    least ``min_cos`` to the normal), of its sharpness there (cosine over distance: a near, frontal view
+    puts more pixels on the plane and misregisters it by fewer millimetres); the best is taken, then every
+    frame within ``pick_sep`` metres and ``pick_sep_deg`` of it is passed over (a dense capture's next
+    frames add nothing new, and their colour is off the same way). So the views fused depend on where the
+    cameras were, not on how densely the walk was sampled. Without ``pick_spread``: the ``max_views`` frames
+    with the largest sum of cosines over a 5 x 5 sample (those seeing most of the plane, frontally)."""
     centers = np.array([f.c2w[:3, 3] for f in frames])
+    axes = np.array([f.c2w[:3, 2] for f in frames])
     w2cs = np.array([f.w2c for f in frames])
     Ks = np.array([f.intrinsics.K for f in frames])
     size = np.array([(f.intrinsics.width, f.intrinsics.height) for f in frames], float)
+    cos_sep = np.cos(np.radians(p.pick_sep_deg))
     out = []
-    for p, pts in zip(planes, grids):
+    for pl, pts in zip(planes, grids):
         h, w = pts.shape[:2]
-        sample = pts[np.ix_(np.linspace(0, h - 1, _PICK_GRID).astype(int),
-                            np.linspace(0, w - 1, _PICK_GRID).astype(int))].reshape(-1, pts.shape[-1])
+        k = p.pick_samples if p.pick_spread else _BEST_GRID
+        sample = pts[np.ix_(np.linspace(0, h - 1, k).astype(int), np.linspace(0, w - 1, k).astype(int))].reshape(-1, pts.shape[-1])
         pc = np.einsum("fij,sj->fsi", w2cs[:, :3, :3], sample) + w2cs[:, None, :3, 3]
         z = pc[..., 2]
         with np.errstate(divide="ignore", invalid="ignore"):
@@ -357,8 +371,24 @@ def _pick_views(planes: Sequence[Plane], frames: Sequence[Frame], grids: list[np
             y = Ks[:, None, 1, 1] * pc[..., 1] / z + Ks[:, None, 1, 2]
         inside = (z > _NEAR) & (x >= 0) & (x < size[:, None, 0]) & (y >= 0) & (y < size[:, None, 1])
         ray = sample[None] - centers[:, None]
-        cos = -(ray @ p.n) / np.maximum(np.linalg.norm(ray, axis=-1), 1e-9)
-        scores = (cos * (inside & (cos >= min_cos))).sum(1)
-        order = np.argsort(-scores)
-        out.append({int(i) for i in order[:max_views] if scores[i] > 0})
+        dist = np.maximum(np.linalg.norm(ray, axis=-1), _NEAR)
+        cos = -(ray @ pl.n) / dist
+        if not p.pick_spread:
+            score = (cos * (inside & (cos >= p.min_cos))).sum(1)
+            out.append({int(i) for i in np.argsort(-score)[:p.max_views] if score[i] > 0})
+            continue
+        sharp = np.where(inside & (cos >= p.min_cos), cos / dist, 0.0)  # (frames, samples)
+        need = np.full(sharp.shape[1], p.pick_need)
+        alive = sharp.any(1)
+        chosen: set[int] = set()
+        while len(chosen) < p.max_views and alive.any():
+            value = np.where(alive, (sharp * (need > 0)).sum(1), 0.0)
+            if value.max() <= 0:
+                break
+            i = int(np.argmax(value))
+            chosen.add(i)
+            need -= sharp[i] > 0
+            alive &= ~((np.linalg.norm(centers - centers[i], axis=1) < p.pick_sep) & (axes @ axes[i] > cos_sep))
+            alive[i] = False
+        out.append(chosen)
     return out

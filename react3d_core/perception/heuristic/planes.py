@@ -4,6 +4,11 @@ Real scan meshes (TSDF, laser) have no seams between fronts and round their corn
 joins a whole L-shaped cabinet run into one region. Here faces vote for a horizontal normal direction
 (area-weighted histogram) and, per dominant direction, for a plane offset; faces near a peak form a
 plane, split into spatially connected pieces on a coarse grid in the plane. Fully vectorized.
+
+Where a plane's faces lie (its pieces, its extent, the stretch its direction is refit on) is read from
+points spread over the faces no farther apart than half the piece grid, not from their centroids alone: a
+decimated scan's faces on flat fronts are 3-5 cm, some much longer, and their centroids are too sparse to
+connect a plane's pieces or reach its edges. Faces smaller than that spacing are their centroid, as before.
 """
 
 from __future__ import annotations
@@ -16,12 +21,17 @@ from scipy import ndimage
 from ...config.heuristic import PlanesConfig
 from ...data.mesh import TriMesh
 from ...geometry import horizontal_right
+from .constants import XYZ
 
 _HALF_TURN = 180.0  # deg: a plane's normal direction is taken modulo a half turn (either sign)
 _HALF_TURN_BINS = 180  # the direction histogram's 1-degree bins over [0, 180)
 _GAUSS_PAD = 4  # sigmas: the refit's density histogram is padded this far for its Gaussian
 _MIN_POINTS = 3  # fewer points fix no direction
 _PIECE_CLOSE = np.ones((3, 3))  # grid cells touching across one empty cell (or at a corner) are one piece
+_SAMPLES_PER_CELL = 2  # faces are sampled at this many points per piece-grid cell along their edges
+_LATTICE_MAX = 64  # ... at most this many steps along a face's longest edge
+_CORNERS = 3  # a triangle's vertices (and barycentric coordinates)
+_CENTROID = np.full((1, _CORNERS), 1.0 / _CORNERS)  # barycentric coordinates of a triangle's centroid
 
 
 @dataclass
@@ -83,11 +93,14 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
         return []
     # orientation-free direction of every face's normal over [0, 180) degrees
     theta = np.degrees(np.arctan2(nrm[:, 1], nrm[:, 0])) % _HALF_TURN
-    planes, found = _vote(vert, theta, area, cen, cfg, min_area, [])
+    vidx = np.flatnonzero(vert)
+    sp, sf, sw = surface_samples(mesh.vertices[mesh.faces[vidx]], area[vidx], cfg.cell / _SAMPLES_PER_CELL)
+    samples = _Samples(sp, vidx[sf], sw, np.zeros(len(cen), bool))
+    planes, found = _vote(vert, theta, area, cen, samples, cfg, min_area, [])
     for _ in range(cfg.revote_rounds):
         # faces no plane explains vote again, away from the directions found: a piece of furniture turned
         # by ~10 degrees in the room is hidden in the first vote by the tail of the walls' peak
-        more, dirs = _vote(vert & ~_explained(planes, cen, cfg), theta, area, cen, cfg, min_area, found)
+        more, dirs = _vote(vert & ~_explained(planes, cen, cfg), theta, area, cen, samples, cfg, min_area, found)
         if not more:
             break
         planes += more
@@ -126,9 +139,10 @@ def _direction(n: np.ndarray) -> float:
     return float(np.degrees(np.arctan2(n[1], n[0])) % _HALF_TURN)
 
 
-def _vote(cand: np.ndarray, theta: np.ndarray, area: np.ndarray, cen: np.ndarray, cfg: PlanesConfig, min_area: float,
-          found: list[float]) -> tuple[list[Plane], list[float]]:
-    """Planes of the faces ``cand`` (bool per face; ``theta``: their normals' directions in degrees) by a
+def _vote(cand: np.ndarray, theta: np.ndarray, area: np.ndarray, cen: np.ndarray, samples: _Samples, cfg: PlanesConfig,
+          min_area: float, found: list[float]) -> tuple[list[Plane], list[float]]:
+    """Planes of the faces ``cand`` (bool per face; ``theta``: their normals' directions in degrees;
+    ``samples``: points spread over the vertical faces, for the refit and the pieces) by a
     direction vote, then an offset vote per direction, and the directions (degrees) of the planes kept.
     Direction peaks closer than ``direction_min_sep_bins`` to one of ``found`` are not taken. A piece that is
     a slice through a surface standing at another angle (``is_slice``: a turned cabinet's front cut along
@@ -169,7 +183,8 @@ def _vote(cand: np.ndarray, theta: np.ndarray, area: np.ndarray, cen: np.ndarray
                 continue
             n_fit = nd
             if refit_deg > 0:  # the face positions fix a wide plane's direction better than its (noisy, skewed) normals
-                n_fit, d_fit = fit_direction(cen[sel, :2], area[sel], nd, cfg)
+                xy, w = samples.of(sel)
+                n_fit, d_fit = fit_direction(xy[:, :2], w, nd, cfg)
                 refit = None
                 if n_fit is not nd:
                     refit = idx_near[(np.abs(cen[idx_near] @ n_fit - d_fit) <= offset_tol) & ~used[idx_near]]
@@ -183,7 +198,8 @@ def _vote(cand: np.ndarray, theta: np.ndarray, area: np.ndarray, cen: np.ndarray
                 if area[sel].sum() < min_area:
                     continue
                 used[sel] = True
-            for p in _pieces(sel, cen, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])), cfg.cell, min_area):
+            for p in _pieces(sel, samples, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])), cfg.cell,
+                             min_area):
                 if cfg.max_skew_deg > 0 and is_slice(p, theta, area, cen, cfg.max_skew_deg):
                     continue
                 planes.append(p)
@@ -210,6 +226,57 @@ def is_slice(p: Plane, theta: np.ndarray, area: np.ndarray, cen: np.ndarray, max
     turn = -np.degrees(np.arctan(float(np.average(du * do, weights=w)) / var))
     lean = float(np.average(_wrapped(theta[p.faces] - _direction(p.n)), weights=w))
     return bool(abs(turn) > max_turn_deg and np.sign(lean) == np.sign(turn))
+
+
+def surface_samples(tri: np.ndarray, area: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Points on the triangles ``tri`` (F, 3, 3) no farther apart than ``spacing``: a face whose longest edge
+    is at most twice ``spacing`` is its centroid; a larger one a barycentric lattice of m = ceil(edge /
+    spacing) steps (its vertices included). Returns the points, each one's face (index into ``tri``) and
+    weight (the face's ``area`` shared among its points)."""
+    edge = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).max(1) if len(tri) else np.zeros(0)
+    m = np.clip(np.ceil(edge / spacing).astype(np.int64), 1, _LATTICE_MAX)
+    m[m <= 2] = 1
+    pts, face, wt = [], [], []
+    for k in np.unique(m):
+        idx = np.flatnonzero(m == k)
+        if k == 1:
+            bary = _CENTROID
+        else:
+            i, j = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
+            ok = i + j <= k
+            bary = np.stack([i[ok], j[ok], k - i[ok] - j[ok]], 1) / k
+        pts.append(np.einsum("bk,fkx->fbx", bary, tri[idx]).reshape(-1, XYZ))
+        face.append(np.repeat(idx, len(bary)))
+        wt.append(np.repeat(area[idx] / len(bary), len(bary)))
+    if not pts:
+        return np.zeros((0, XYZ)), np.zeros(0, np.int64), np.zeros(0)
+    return np.concatenate(pts), np.concatenate(face), np.concatenate(wt)
+
+
+@dataclass
+class _Samples:
+    """Points spread over the vertical faces (``surface_samples``): position, face (mesh index), weight."""
+
+    points: np.ndarray
+    face: np.ndarray
+    weight: np.ndarray
+    _mask: np.ndarray  # scratch: one bool per mesh face
+
+    def of(self, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points and weights of the faces ``faces`` (mesh indices)."""
+        self._mask[faces] = True
+        m = self._mask[self.face]
+        self._mask[faces] = False
+        return self.points[m], self.weight[m]
+
+    def with_face(self, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Points of the faces ``faces`` and each one's position in ``faces``."""
+        pos = np.full(len(self._mask), -1, np.int64)
+        pos[faces] = np.arange(len(faces))
+        k = pos[self.face]
+        m = k >= 0
+        return self.points[m], k[m]
+
 
 def fit_direction(xy: np.ndarray, w: np.ndarray, nd: np.ndarray, cfg: PlanesConfig) -> tuple[np.ndarray, float]:
     """Horizontal normal and offset of the points ``xy`` (weights ``w``): of the directions within
@@ -269,23 +336,28 @@ def _flip(p: Plane) -> Plane:
     return Plane(-p.n, u, -p.d, p.faces, (-p.extent_u[1], -p.extent_u[0]), p.extent_v, p.area)
 
 
-def _pieces(sel: np.ndarray, cen: np.ndarray, area: np.ndarray, n: np.ndarray, d: float, cell: float,
+def _pieces(sel: np.ndarray, samples: _Samples, area: np.ndarray, n: np.ndarray, d: float, cell: float,
             min_area: float) -> list[Plane]:
-    """Split the faces ``sel`` of one plane into pieces connected on a ``cell`` grid."""
+    """Split the faces ``sel`` of one plane into pieces connected on a ``cell`` grid (their surface
+    samples'); a piece's extent is its samples'."""
     u = horizontal_right(n)  # right-hand side when looking at the plane from its front
-    pu, pv = cen[sel] @ u, cen[sel, 2]
+    pts, owner = samples.with_face(sel)
+    pu, pv = pts @ u, pts[:, 2]
     iu = np.floor((pu - pu.min()) / cell).astype(int)
     iv = np.floor((pv - pv.min()) / cell).astype(int)
     grid = np.zeros((iv.max() + 1, iu.max() + 1), bool)
     grid[iv, iu] = True
     lab, k = ndimage.label(ndimage.binary_closing(grid, _PIECE_CLOSE, border_value=0) | grid, _PIECE_CLOSE)
-    fl = lab[iv, iu]
+    sl = lab[iv, iu]
+    fl = np.zeros(len(sel), np.int64)
+    fl[owner] = sl  # a face's samples lie closer together than a cell: one piece
     out = []
     for j in range(1, k + 1):
         m = fl == j
         a = float(area[sel[m]].sum())
         if a < min_area:
             continue
-        out.append(Plane(n.copy(), u, d, sel[m], (float(pu[m].min()), float(pu[m].max())),
-                         (float(pv[m].min()), float(pv[m].max())), a))
+        ms = sl == j
+        out.append(Plane(n.copy(), u, d, sel[m], (float(pu[ms].min()), float(pu[ms].max())),
+                         (float(pv[ms].min()), float(pv[ms].max())), a))
     return out

@@ -18,7 +18,8 @@ from react3d_core.perception.heuristic.front_cells import find_handles, split_ce
 from react3d_core.perception.heuristic.fronts import find_fronts
 from react3d_core.perception.heuristic.image_fronts import find_image_fronts
 from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, _nanmedian
-from react3d_core.perception.heuristic.planes import Plane, vertical_planes
+from react3d_core.perception.heuristic.plane_surface import PlaneSurface, cast_surface, flat_surface
+from react3d_core.perception.heuristic.planes import Plane, surface_samples, vertical_planes
 from react3d_core.raster import Rasterizer
 from react3d_core.synthetic.render import RayCaster
 
@@ -79,6 +80,20 @@ def _ortho(img: np.ndarray, res: float = 0.005) -> Orthophoto:
     plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
                   (0.0, w * res), (0.0, h * res), w * h * res * res)
     return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+
+
+def _splat_surface(o: Orthophoto, cen: np.ndarray, nrm: np.ndarray) -> PlaneSurface:
+    """The ``PlaneSurface`` a cast would give for small patches at ``cen`` facing ``nrm``: each patch's
+    offset in front of the plane in its pixel (the front-most where two share one), NaN elsewhere."""
+    h, w = o.n_views.shape
+    p = o.plane
+    dn = cen @ p.n - p.d
+    c = np.floor((cen @ p.u - o.u0) / o.res).astype(int)
+    r = np.floor((o.v_top - cen[:, 2]) / o.res).astype(int)
+    front, cos = np.full((h, w), np.nan, np.float32), np.full((h, w), np.nan, np.float32)
+    for k in np.argsort(dn):  # the front-most patch last
+        front[r[k], c[k]], cos[r[k], c[k]] = dn[k], nrm[k] @ p.n
+    return PlaneSurface(np.where(np.abs(front) <= PlanesConfig().offset_tol, front, np.nan), front, cos)
 
 
 def test_cells_split_at_seams_and_between_handles() -> None:
@@ -152,12 +167,14 @@ def _seamless_cabinet_scene(scale: float = 1.0, shift_px: tuple[float, float] = 
     return mesh, frames, images
 
 
-@pytest.mark.parametrize("scale, shift", [(1.0, (0.0, 0.0)), (0.92, (6.0, -4.0))])
-def test_seamless_mesh_splits_into_two_doors_from_the_images(scale: float, shift: tuple[float, float]) -> None:
+@pytest.mark.parametrize("scale, shift, opt", [(1.0, (0.0, 0.0), {}), (0.92, (6.0, -4.0), {}),
+                                              (1.0, (0.0, 0.0), {"image": {"surface_rays": True}, "ortho": {"pick_spread": True}})])
+def test_seamless_mesh_splits_into_two_doors_from_the_images(scale: float, shift: tuple[float, float], opt: dict) -> None:
+    """Also with the plane surface from rays and the views picked for spread (both opt-in)."""
     mesh, frames, images = _seamless_cabinet_scene(scale, shift)
     facets = planar_facets(mesh)
     assert facets.n <= 4  # the mesh alone has no seam between the doors
-    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id])
+    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], HeuristicConfig(**opt))
     fronts = sorted(res.fronts, key=lambda f: f.center[0])
     assert len(fronts) == 2, [(np.round(f.center, 2), f.w, f.h) for f in fronts]
     for f, (u0, u1) in zip(fronts, ((0.0, 0.6), (0.6, 1.2))):
@@ -432,16 +449,18 @@ def test_enclosed_handle_shadows_hand_computed() -> None:
 def test_protrusion_map_grows_the_splat_by_one_pixel() -> None:
     """One outward face 3 cm in front of the plane (4 mm px) marks the 3 x 3 px around its centroid's
     pixel; a face 1 cm in front (under the 1.2 cm minimum) or facing away marks nothing."""
-    from react3d_core.perception.heuristic.image_fronts import protrusion_map
+    from react3d_core.perception.heuristic.image_fronts import protrusion_from_faces, protrusion_map
 
     o = _ortho(np.ones((50, 60, 3), np.float32), res=0.004)        # plane y = 0, facing -y; v_top = 0.2
     cen = np.array([[0.1 + 0.002, -0.03, 0.2 - 0.1 - 0.002],      # pixel (row 25, col 25)
                     [0.05, -0.01, 0.1], [0.15, -0.03, 0.1]])
     nrm = np.array([[0.0, -1.0, 0.0], [0.0, -1.0, 0.0], [0.0, 1.0, 0.0]])
-    m = protrusion_map(o, cen, nrm, HandleConfig(), 0.0, PlanesConfig().offset_tol)
+    m = protrusion_map(o, _splat_surface(o, cen, nrm), HandleConfig(), 0.0, PlanesConfig().offset_tol)
     expected = np.zeros((50, 60), bool)
     expected[24:27, 24:27] = True
     assert np.array_equal(m, expected)
+    # the same faces splatted by centroid (image.surface_rays off) mark the same pixels
+    assert np.array_equal(protrusion_from_faces(o, cen, nrm, HandleConfig(), 0.0, PlanesConfig().offset_tol), expected)
 
 
 def test_standing_bar_in_the_mesh_is_a_handle() -> None:
@@ -454,7 +473,8 @@ def test_standing_bar_in_the_mesh_is_a_handle() -> None:
     cov = np.ones((h, w), bool)
     zs = 0.6 - (np.arange(30, 70) + 0.5) * res                     # rows 30-69
     cen = np.array([[(c + 0.5) * res, -0.03, z] for c in (50, 51) for z in zs])
-    bar = protrusion_map(o, cen, np.tile([0.0, -1.0, 0.0], (len(cen), 1)), HandleConfig(), 0.0, PlanesConfig().offset_tol)
+    bar = protrusion_map(o, _splat_surface(o, cen, np.tile([0.0, -1.0, 0.0], (len(cen), 1))), HandleConfig(), 0.0,
+                         PlanesConfig().offset_tol)
     hs = find_handles(o, cov, HeuristicConfig(), None, bar, cov)
     assert len(hs) == 1 and not hs[0].horizontal
     assert hs[0].box == (49, 29, 53, 71)
@@ -507,9 +527,10 @@ def test_protrusion_is_measured_from_the_surface_around() -> None:
     bar = np.array([[(c + 0.5) * res, -0.015 - 0.03, 0.4 - (r + 0.5) * res] for c in (150, 151) for r in range(30, 70)])
     cen = np.concatenate([wall, bar])
     nrm = np.tile([0.0, -1.0, 0.0], (len(cen), 1))
-    plane = protrusion_map(o, cen, nrm, HandleConfig(), 0.0, PlanesConfig().offset_tol)
+    surf = _splat_surface(o, cen, nrm)
+    plane = protrusion_map(o, surf, HandleConfig(), 0.0, PlanesConfig().offset_tol)
     assert plane[:, 100:].all() and not plane[:, :99].any()
-    m = protrusion_map(o, cen, nrm, HandleConfig(), 0.12, PlanesConfig().offset_tol)
+    m = protrusion_map(o, surf, HandleConfig(), 0.12, PlanesConfig().offset_tol)
     assert m[30:70, 150:152].all()
     assert m.sum() == m[28:72, 148:154].sum() and m.sum() <= 44 * 6       # only the bar (closed, grown by 1 px)
 

@@ -80,3 +80,33 @@ def test_disagreement_is_the_mean_per_pixel_variance_hand_computed() -> None:
     assert np.isnan(_disagreement(views[:2], frames, gray, ColourCalibration(), 400, CalibrationConfig()))
     # a focal scale that throws every point out of the image leaves nothing to compare
     assert np.isnan(_disagreement(views, frames, gray, ColourCalibration(scale=20.0), 400, CalibrationConfig()))
+
+
+def _walk_frames() -> list[Frame]:
+    """Six frames of a dense walk, 2 cm apart, 1.4-1.5 m in front of a wall at y = 0, all looking at
+    (0, 0, 0.5); then one frame from each side, 1.4 m away at 34 degrees."""
+    intr = Intrinsics.from_K(np.array([[300.0, 0, 320], [0, 300.0, 240], [0, 0, 1]]), 640, 480)
+    eyes = [(0.0, -1.5 + 0.02 * k, 0.5) for k in range(6)] + [(-0.8, -1.2, 0.5), (0.8, -1.2, 0.5)]
+    return [Frame(frame_id=f"f{i}", rgb=ImageRef(path=Path(f"f{i}.png"), kind="png"), intrinsics=intr,
+                  pose=look_at(np.array(e), np.array([0.0, 0.0, 0.5]))) for i, e in enumerate(eyes)]
+
+
+def test_views_are_picked_apart_not_from_one_stretch_of_the_walk() -> None:
+    """A 2 m x 1 m wall, three views to fuse. Picked for spread: the nearest walk frame (sharpest: cosine
+    over distance), then its neighbours within 15 cm and 10 degrees are passed over and the two side
+    frames follow. Without ``pick_spread`` (the default) the three are all walk frames, alike and sharing
+    one occluder."""
+    from react3d_core.config.heuristic import OrthoConfig
+    from react3d_core.perception.heuristic.orthophoto import _pick_views
+    from react3d_core.perception.heuristic.planes import Plane
+
+    u, v = np.meshgrid(np.arange(-1.0, 1.0, 0.01), np.arange(1.0, 0.0, -0.01))
+    grid = np.stack([u, np.zeros_like(u), v], -1)
+    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
+                  (-1.0, 1.0), (0.0, 1.0), 2.0)
+    frames = _walk_frames()
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=3, pick_spread=True)) == [{5, 6, 7}]
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=3))[0] <= set(range(6))
+    # with room for all, every frame the spread passed over stays out; without the cap on neighbours, all
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=30, pick_spread=True)) == [{5, 6, 7}]
+    assert _pick_views([plane], frames, [grid], OrthoConfig(max_views=30, pick_spread=True, pick_sep=0.0)) == [set(range(8))]
