@@ -7,30 +7,19 @@ from __future__ import annotations
 
 import json
 import threading
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from deployments.local_cluster import S3Server, s3rver_command
+from deployments.local_cluster import s3rver_command
 
 pytestmark = pytest.mark.skipif(s3rver_command() is None, reason="s3rver not installed (bash scripts/setup.sh test)")
 
 
-@pytest.fixture(scope="module")
-def s3(tmp_path_factory: pytest.TempPathFactory) -> Iterator[S3Server]:
-    with S3Server(tmp_path_factory.mktemp("s3") / "data") as srv:
-        yield srv
-
-
 @pytest.fixture()
-def remote(s3: S3Server, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> str:
-    for k, v in s3.env.items():
-        monkeypatch.setenv(k, v)
-    monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "cache"))
-    monkeypatch.delenv("REACT3D_STORE", raising=False)
-    return s3.url(tmp_path.name)
+def remote(s3_prefix: str) -> str:
+    return s3_prefix
 
 
 def _output(folder: Path, tag: str, n_extra: int = 0) -> Path:

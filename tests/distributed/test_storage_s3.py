@@ -5,7 +5,6 @@ pointer last, and a prefix holding someone else's files is refused. Fast (~5 s);
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -14,12 +13,6 @@ import pytest
 from deployments.local_cluster import S3Server, s3rver_command
 
 pytestmark = pytest.mark.skipif(s3rver_command() is None, reason="s3rver not installed (bash scripts/setup.sh test)")
-
-
-@pytest.fixture(scope="module")
-def s3(tmp_path_factory: pytest.TempPathFactory) -> Iterator[S3Server]:
-    with S3Server(tmp_path_factory.mktemp("s3") / "data") as srv:
-        yield srv
 
 
 @pytest.fixture()

@@ -8,12 +8,11 @@ import hashlib
 import json
 import os
 import time
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 
-from deployments.local_cluster import S3Server, s3rver_command
+from deployments.local_cluster import S3Server
 
 
 def _sha(tag: str) -> str:
@@ -129,14 +128,6 @@ def test_store_clean_refuses_when_no_record_is_found(local_store: Path, tmp_path
     before = _files(local_store)
     assert main(["cache", "clean", "--store"]) == 2
     assert _files(local_store) == before
-
-
-@pytest.fixture(scope="module")
-def s3(tmp_path_factory: pytest.TempPathFactory) -> Iterator[S3Server]:
-    if s3rver_command() is None:
-        pytest.skip("s3rver not installed (bash scripts/setup.sh test)")
-    with S3Server(tmp_path_factory.mktemp("s3") / "data") as srv:
-        yield srv
 
 
 def test_bucket_store_dry_run_lists_exactly_the_unreferenced_then_clean_removes_only_those(
