@@ -21,6 +21,7 @@ import trimesh
 
 from react3d_core.config.export import ExportConfig
 from react3d_core.data import OBB, Articulation, InteractiveObject, InteractiveScene, TriMesh, save_mesh
+from tests.physics.scenes import box, open_box
 
 
 def colour(v: np.ndarray) -> np.ndarray:
@@ -34,11 +35,6 @@ def _mesh(parts: list[trimesh.Trimesh]) -> TriMesh:
     return TriMesh(m.vertices, m.faces, colour(np.asarray(m.vertices)))
 
 
-def box(lo: tuple[float, float, float], hi: tuple[float, float, float]) -> trimesh.Trimesh:
-    lo_, hi_ = np.asarray(lo, float), np.asarray(hi, float)
-    return trimesh.creation.box(extents=hi_ - lo_).apply_translation((lo_ + hi_) / 2)
-
-
 def grid(origin: np.ndarray, u: np.ndarray, v: np.ndarray, n: int) -> trimesh.Trimesh:
     """An open n x n quad grid spanning origin + [0,1] u + [0,1] v."""
     s = np.linspace(0, 1, n + 1)
@@ -48,25 +44,6 @@ def grid(origin: np.ndarray, u: np.ndarray, v: np.ndarray, n: int) -> trimesh.Tr
     q = np.stack([idx[:-1, :-1], idx[1:, :-1], idx[1:, 1:], idx[:-1, 1:]], -1).reshape(-1, 4)
     faces = np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]])
     return trimesh.Trimesh(verts, faces, process=False)
-
-
-def open_box(lo: tuple[float, float, float], hi: tuple[float, float, float], t: float, open_side: str) -> list[trimesh.Trimesh]:
-    """Five walls of thickness ``t`` inside [lo, hi]; ``open_side`` is '-y' (front) or '+z' (top)."""
-    x0, y0, z0 = lo
-    x1, y1, z1 = hi
-    walls = {
-        "-x": box((x0, y0, z0), (x0 + t, y1, z1)),
-        "+x": box((x1 - t, y0, z0), (x1, y1, z1)),
-        "-z": box((x0 + t, y0, z0), (x1 - t, y1, z0 + t)),
-        "+z": box((x0 + t, y0, z1 - t), (x1 - t, y1, z1)),
-        "+y": box((x0 + t, y1 - t, z0 + t), (x1 - t, y1, z1 - t)),
-        "-y": box((x0 + t, y0, z0 + t), (x1 - t, y0 + t, z1 - t)),
-    }
-    walls.pop(open_side)
-    if open_side == "+z":  # container: the +y/-y walls span the full height
-        walls["+y"] = box((x0 + t, y1 - t, z0 + t), (x1 - t, y1, z1))
-        walls["-y"] = box((x0 + t, y0, z0 + t), (x1 - t, y0 + t, z1))
-    return list(walls.values())
 
 
 DOOR = Articulation(joint_type="revolute", axis=(0, 0, -1), origin=(-0.99, 0.48, 0.32), lower=0.0, upper=np.pi / 2, limit_source="test")
