@@ -135,6 +135,7 @@ class ImageConfig(StageConfig):
     texture_factor: float = Field(3.0, ge=0, description="Handle/seam thresholds rise to this many times the plane's median response (textured planes).")
     face_depth: tuple[float, float] = Field((-0.02, 0.07), description="Faces this far behind/in front of the plane are taken into a front (m).")
     surface_rays: bool = Field(False, description="A plane's coverage and the handles standing out of it are read from rays cast along its normal through every orthophoto pixel (the same on any tessellation of the scan); off: from its faces' centroids splatted on the grid (a decimated scan's planes come out mostly uncovered).")
+    seen_reach: float = Field(0.05, ge=0, description="With surface_rays, the plane's coverage is only the scan surface within this (m) of a pixel some view sees (handle shadows and the outlines taken off every view at depth edges stay in): a complete mesh holds surface no camera saw (the wall behind cabinets), whose cells became fronts (0: every surface in the slab).")
     coverage_close: float = Field(0.02, ge=0, description="The plane's coverage (its faces' centroids, or with surface_rays the scan surface lying flat in its slab, on the orthophoto grid) is closed over this (m).")
     outline_fill_px: int = Field(20, ge=0, description="Holes and notches up to this many orthophoto px wide are inside a plane's outline (handle shadows).")
     min_faces: int = Field(4, ge=1, description="An image front holds at least this many mesh faces.")

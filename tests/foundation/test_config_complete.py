@@ -285,6 +285,7 @@ DEFAULTS = {
     "perception.heuristic.image.texture_factor": 3.0,
     "perception.heuristic.image.face_depth": (-0.02, 0.07),
     "perception.heuristic.image.surface_rays": False,
+    "perception.heuristic.image.seen_reach": 0.05,
     "perception.heuristic.image.coverage_close": 0.02,
     "perception.heuristic.image.outline_fill_px": 20,
     "perception.heuristic.image.min_faces": 4,

@@ -98,6 +98,16 @@ def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: fl
     return keep[lab]
 
 
+def seen_near(seen: np.ndarray, res: float, reach: float) -> np.ndarray:
+    """Pixels within ``reach`` m of one that ``seen`` marks: what the views show of a plane, with its
+    holes (handle shadows) and the outlines the depth-edge erosion took off every view, but not the
+    plane's stretches that no view sees (a wall behind cabinets: the scan may hold it, no camera did)."""
+    r = int(round(reach / res))
+    if r <= 0:
+        return seen.copy()
+    return cv2.dilate(seen.astype(np.uint8), cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))).astype(bool)
+
+
 def coverage_map(o: Orthophoto, flat: np.ndarray, min_area: float, close: float) -> np.ndarray:
     """Grid pixels where the plane is: the scan surface lying flat in its slab (``flat``, from
     ``plane_surface.flat_surface``), holes up to ``close`` m closed, fragments under ``min_area`` m² dropped."""
@@ -279,8 +289,10 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         if cfg.image.surface_rays:
             surf = cast_surface(o.grid_points(), o.plane.n, raster, cfg.planes.offset_tol, hc.protrusion_depth[1],
                                 cfg.planes.offset_tol)
-            cov = coverage_map(o, flat_surface(surf.offset, o.res, cfg.planes.slope_win, cfg.planes.angle_tol_deg),
-                               cfg.planes.min_fragment_area, cfg.image.coverage_close)
+            flat = flat_surface(surf.offset, o.res, cfg.planes.slope_win, cfg.planes.angle_tol_deg)
+            if cfg.image.seen_reach > 0:
+                flat &= seen_near(o.n_views > 0, o.res, cfg.image.seen_reach)
+            cov = coverage_map(o, flat, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         else:
             cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)

@@ -446,6 +446,25 @@ def test_enclosed_handle_shadows_hand_computed() -> None:
     assert np.array_equal(holes, expected)
 
 
+def test_seen_near_reaches_a_set_distance_hand_computed() -> None:
+    """1 cm px, reach 2 cm (OpenCV's 5 x 5 ellipse: 2 px straight up, down and sideways, 1 px up or down
+    when 2 px sideways, not (2, 1)): a 3 px hole in what the views see (a handle's shadow)
+    is filled, the seen part grows by 2 px (what the depth-edge erosion took off), and a stretch farther
+    than that from any seen pixel (a wall behind a cabinet) stays out."""
+    from react3d_core.perception.heuristic.image_fronts import seen_near
+
+    seen = np.zeros((30, 60), bool)
+    seen[5:25, 5:30] = True
+    seen[12:15, 12:15] = False   # 3 x 3 px hole inside
+    got = seen_near(seen, 0.01, 0.02)
+    expected = np.zeros((30, 60), bool)
+    expected[3:27, 5:30] = True  # 2 px up and down
+    expected[4:26, 3:32] = True  # 2 px left and right, and 1 px up or down with them
+    assert np.array_equal(got, expected)
+    assert not got[:, 33:].any() and not got[28:].any()
+    assert np.array_equal(seen_near(seen, 0.01, 0.0), seen)
+
+
 def test_protrusion_map_grows_the_splat_by_one_pixel() -> None:
     """One outward face 3 cm in front of the plane (4 mm px) marks the 3 x 3 px around its centroid's
     pixel; a face 1 cm in front (under the 1.2 cm minimum) or facing away marks nothing."""
