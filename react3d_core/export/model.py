@@ -66,6 +66,7 @@ class Joint:
     parent: str
     child: str
     articulation: Articulation
+    damping: float = 0.0  # N s/m or N m s/rad (``joint_damping_for``)
 
 
 @dataclass
@@ -154,6 +155,14 @@ def split_territories(objects: list[_Object], margin: float, box_max_loss: float
                     k2 += k3
                 cut += k1 + k2
     return cut
+
+
+def joint_damping_for(inertia: float, config: ExportConfig) -> float:
+    """The joint's damping: ``joint_damping``, but never more than ``joint_damping_max_rate`` times what
+    the joint moves (its mass or moment about the hinge). A fixed damping on a light part (a small flap
+    or a fragment at the minimum mass) stalls any drive scaled to its inertia, and an explicit integrator
+    (PyBullet) blows up once ``damping * dt / inertia`` exceeds 2."""
+    return float(min(config.joint_damping, config.joint_damping_max_rate * max(inertia, 0.0)))
 
 
 def obstacle_digest(obstacles: list[Obstacle]) -> str:
@@ -290,11 +299,13 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
             parent = names["base"]
         else:
             parent = "background"
+        inertial = inertial_from_pieces(o.part, config.density_kg_m3, config.min_mass_kg)
         links.append(
             Link(
                 names["part"], np.asarray(art.origin, float), [bake_texture(m, config) for m in o.part_meshes], o.part,
-                inertial=inertial_from_pieces(o.part, config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="part",
+                inertial=inertial, object_id=obj.object_id, role="part",
             )
         )
-        joints.append(Joint(names["joint"], obj.object_id, parent, names["part"], art))
+        damping = joint_damping_for(inertial.about_joint(art.joint_type, np.asarray(art.axis, float), np.asarray(art.origin, float)), config)
+        joints.append(Joint(names["joint"], obj.object_id, parent, names["part"], art, damping))
     return SceneModel(safe_name(scene.scene_id), links, joints, stats)

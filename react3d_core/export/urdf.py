@@ -117,7 +117,7 @@ def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
             f'    <origin xyz="{_v(child.frame - parent.frame)}" rpy="0 0 0"/>',
             f'    <axis xyz="{_v(a.axis)}"/>',
             f'    <limit lower="{_f(a.lower)}" upper="{_f(a.upper)}" effort="{_f(config.joint_effort)}" velocity="{_f(config.joint_velocity)}"/>',
-            f'    <dynamics damping="{_f(config.joint_damping)}" friction="0"/>',
+            f'    <dynamics damping="{_f(j.damping)}" friction="0"/>',
             "  </joint>",
         ]
     out.append("</robot>")
