@@ -129,6 +129,29 @@ TERRITORY_BOX_MAX_LOSS = 0.9
 stays whole; one it crosses (a side wall of a box turned towards its neighbour) is cut."""
 
 
+TERRITORY_WALL_SHIFT_M = 0.05
+"""How far a carcass wall lying wholly on a neighbour's side of the territory plane is moved back to its own
+side (m); one further away is left to be dropped."""
+
+
+def shift_walls(base: list[ConvexPiece], m: np.ndarray, c: float, max_shift: float = TERRITORY_WALL_SHIFT_M) -> list[ConvexPiece]:
+    """Carcass walls lying wholly past the plane m . x = c, within ``max_shift`` of it, moved along -m until
+    their far face lies on it. Two estimated carcasses stacked or side by side interleave (a cupboard's
+    floor a few cm below the drawer box's roof beneath it): cutting each to its side drops both of those
+    walls and leaves one open space through both cavities; moved, each keeps its own wall at the
+    boundary. Walls the plane crosses are left to the cut."""
+    out = []
+    for p in base:
+        s = p.vertices @ m
+        lo = float(s.min())
+        if c < lo <= c + max_shift:
+            shift = float(s.max()) - c
+            p = ConvexPiece(p.vertices - shift * m, p.faces, p.source,
+                            None if p.box is None else np.concatenate([p.box[:3] - shift * m, p.box[3:]]))
+        out.append(p)
+    return out
+
+
 def split_territories(objects: list[_Object], margin: float, box_max_loss: float) -> int:
     """Neighbours whose pieces (front, drawer box, carcass) meet are each cut back to their own side
     of a plane between their fronts (``clearance.territory_plane``), ``margin / 2`` off it: two
@@ -151,7 +174,7 @@ def split_territories(objects: list[_Object], margin: float, box_max_loss: float
                 inner, k2 = keep_side(o.part[o.n_front :], mm, cc, max_loss=box_max_loss)
                 o.part, o.n_front = front + inner, len(front)
                 if o.base is not None:
-                    o.base, k3 = keep_side(o.base, mm, cc)
+                    o.base, k3 = keep_side(shift_walls(o.base, mm, cc), mm, cc)
                     k2 += k3
                 cut += k1 + k2
     return cut
