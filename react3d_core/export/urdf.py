@@ -63,7 +63,9 @@ def _box(piece: ConvexPiece, frame: np.ndarray) -> tuple[str, str, str]:
 POLICY = (
     "<!-- Collision policy: colliders are separated at rest and around every part's path. Load with self-collision on and "
     "parent exclusion (PyBullet: URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_EXCLUDE_PARENT; SAPIEN/PhysX do this by "
-    "default) so a part never collides with its own carcass (its parent link) and collides with everything else. -->"
+    "default) so a part never collides with its own carcass (its parent link) and collides with everything else. Colliders are "
+    "a few mm apart: in PyBullet set contactBreakingThreshold below that gap (setPhysicsEngineParameter, e.g. 0.002), or "
+    "contact points kept from 2 cm away jam a part sliding past its neighbour. -->"
 )
 
 
