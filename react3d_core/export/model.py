@@ -152,14 +152,28 @@ def shift_walls(base: list[ConvexPiece], m: np.ndarray, c: float, max_shift: flo
     return out
 
 
+TERRITORY_FRONT_OVERLAP_MAX = 0.1
+"""Two fronts of which one reaches past the territory plane by more than this share of its extent across it
+overlap (a duplicate detection): the plane is no partition between them, so no carcass wall is moved onto it."""
+
+
+def fronts_apart(sa: np.ndarray, sb: np.ndarray, c: float, overlap_max: float = TERRITORY_FRONT_OVERLAP_MAX) -> bool:
+    """Whether the plane at ``c`` parts two fronts, given their vertices' positions ``sa`` / ``sb`` along its
+    normal (A's side below ``c``): each reaches past it by at most ``overlap_max`` of its own extent."""
+    over_a = max(0.0, float(sa.max()) - c) / max(float(np.ptp(sa)), 1e-9)
+    over_b = max(0.0, c - float(sb.min())) / max(float(np.ptp(sb)), 1e-9)
+    return max(over_a, over_b) <= overlap_max
+
+
 def split_territories(objects: list[_Object], margin: float, box_max_loss: float) -> int:
     """Neighbours whose pieces (front, drawer box, carcass) meet are each cut back to their own side
     of a plane between their fronts (``clearance.territory_plane``), ``margin / 2`` off it: two
     carcasses estimated at an angle, or a drawer box reaching behind its neighbour, then share the
     disputed space instead of both claiming it. A drawer-box piece that would lose more than
     ``box_max_loss`` of itself stays whole (a drawer's bottom a few mm below the plane, where its
-    neighbour's front overlaps its own): ``clear_paths`` then cuts whichever of the two loses less.
-    Returns the number of pieces cut."""
+    neighbour's front overlaps its own): ``clear_paths`` then cuts whichever of the two loses less. A
+    carcass wall wholly on the neighbour's side is moved back onto the plane (``shift_walls``) when the
+    plane parts the two fronts (``fronts_apart``). Returns the number of pieces cut."""
     cut = 0
     for i, a in enumerate(objects):
         for b in objects[i + 1 :]:
@@ -169,12 +183,13 @@ def split_territories(objects: list[_Object], margin: float, box_max_loss: float
             fb = np.vstack([p.vertices for p in b.part[: b.n_front]])
             m, c = territory_plane(fa, np.asarray(a.obj.front_normal), fb, np.asarray(b.obj.front_normal),
                                    axes=np.vstack([np.asarray(a.obj.obb.axes, float), np.asarray(b.obj.obb.axes, float)]))
+            apart = fronts_apart(fa @ m, fb @ m, c)
             for o, (mm, cc) in ((a, (m, c - margin / 2)), (b, (-m, -c - margin / 2))):
                 front, k1 = keep_side(o.part[: o.n_front], mm, cc)
                 inner, k2 = keep_side(o.part[o.n_front :], mm, cc, max_loss=box_max_loss)
                 o.part, o.n_front = front + inner, len(front)
                 if o.base is not None:
-                    o.base, k3 = keep_side(shift_walls(o.base, mm, cc), mm, cc)
+                    o.base, k3 = keep_side(shift_walls(o.base, mm, cc) if apart else o.base, mm, cc)
                     k2 += k3
                 cut += k1 + k2
     return cut

@@ -240,3 +240,12 @@ def test_interleaved_carcass_walls_are_moved_to_their_side_not_dropped():
     assert out[1] is far and out[2] is side
     kept, _ = keep_side(out, m, c)
     assert len(kept) == 2  # the moved floor and the cut side; the far plate is dropped
+
+
+def test_fronts_apart_only_when_the_plane_parts_them():
+    from react3d_core.export.model import fronts_apart
+
+    # stacked fronts, plane at 0.48: a drawer below, a 1.66 m door above reaching 3.1 cm below it (1.9 %): apart
+    assert fronts_apart(np.array([0.052, 0.478]), np.array([0.449, 2.107]), 0.48)
+    # a 0.117 m fragment with half of its width past the plane (a duplicate of its neighbour): not apart
+    assert not fronts_apart(np.array([2.644, 2.761]), np.array([2.64, 3.14]), 2.70)
