@@ -23,7 +23,11 @@ class ExportConfig(StageConfig):
     max_convex_hulls: int = Field(16, ge=1, description="Convex pieces per movable body.")
     joint_effort: float = Field(50.0, gt=0, description="URDF effort limit.")
     joint_velocity: float = Field(1.0, gt=0, description="URDF velocity limit.")
-    joint_damping: float = Field(1.0, ge=0, description="Joint damping.")
+    joint_damping: float = Field(1.0, ge=0, description="Joint damping (N s/m or N m s/rad), capped per joint by joint_damping_max_rate.")
+    joint_damping_max_rate: float = Field(
+        10.0, gt=0,
+        description="A joint's damping is at most this many times what it moves (its mass, or its moment about the hinge), "
+                    "in 1/s: a light part keeps a drive able to move it and an explicit integrator stable.")
     ros_package: bool = Field(False, description="Also write a ROS 2 description package with package:// paths.")
     xatlas_max_faces: int = Field(
         2000, ge=1,

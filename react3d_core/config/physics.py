@@ -34,6 +34,9 @@ class PhysicsConfig(StageConfig):
     max_speed_rad: float = Field(20.0, gt=0, description="Joint speed above this is a blow-up (rad/s).")
     max_speed_m: float = Field(5.0, gt=0, description="Joint speed above this is a blow-up (m/s).")
     timestep: float = Field(1 / 240, gt=0, le=0.02, description="PyBullet and SAPIEN time step (s); MuJoCo uses the MJCF's own.")
+    pybullet_contact_breaking_m: float = Field(
+        0.002, gt=0, description="PyBullet's contactBreakingThreshold (m), below the export's collider clearance: its default "
+                                 "(0.02) keeps contact points of colliders a few mm apart, whose stale normals jam a part sliding past them.")
     contact_hz: float = Field(100.0, gt=0, description="Contacts of a driven part are read at this rate (every step if the step is longer); a probe's every step.")
     probe_radius_m: float = Field(0.03, gt=0, description="Probe sphere radius (shrunk to 15 % of a small cavity's smallest side).")
     probe_mass_kg: float = Field(0.1, gt=0, description="Probe sphere mass.")

@@ -9,7 +9,7 @@ from ..stage import StageSpec
 from .importer import import_urdf
 from .scene import FORMATS, export_scene
 
-STAGE_VERSION = "3"  # 2: one shared asset folder, binary USD, export_sizes; 3: colliders kept clear at rest and of every part's path, collision policy stated per format
+STAGE_VERSION = "4"  # 2: one shared asset folder, binary USD, export_sizes; 3: colliders kept clear at rest and of every part's path, collision policy stated per format; 4: joint damping capped by what the joint moves, interleaved carcass walls moved to the territory plane
 STAGE = StageSpec("export", __name__, STAGE_VERSION, sections=("export",), upstream=("assembly", "texture"))
 
 __all__ = ["STAGE", "FORMATS", "STAGE_VERSION", "export_scene", "import_urdf"]

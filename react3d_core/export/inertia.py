@@ -39,6 +39,16 @@ class Inertial:
         x, y, z, w = Rotation.from_matrix(self.axes).as_quat()
         return np.array([w, x, y, z])
 
+    def about_joint(self, joint_type: str, axis: np.ndarray, anchor: np.ndarray) -> float:
+        """What a joint moves: the mass along a slide, or the moment about a hinge's line (the inertia
+        about the parallel line through the centre of mass plus ``m d^2``)."""
+        if joint_type != "revolute":
+            return float(self.mass)
+        a = np.asarray(axis, float) / np.linalg.norm(axis)
+        r = np.asarray(self.com, float) - np.asarray(anchor, float)
+        d = r - np.dot(r, a) * a
+        return float(a @ self.tensor() @ a + self.mass * np.dot(d, d))
+
 
 def combine(masses: np.ndarray, coms: np.ndarray, tensors: np.ndarray) -> tuple[float, np.ndarray, np.ndarray]:
     """Sum rigid pieces: total mass, COM, tensor about the COM (parallel-axis theorem)."""

@@ -91,7 +91,6 @@ def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
         "  <default>",
         '    <default class="visual"><geom contype="0" conaffinity="0" group="1" density="0"/></default>',
         '    <default class="collision"><geom contype="1" conaffinity="1" group="3" rgba="0.5 0.5 0.5 0.3" density="0"/></default>',
-        f'    <joint damping="{_f(config.joint_damping)}"/>',
         "  </default>",
         "  <asset>",
     ]
@@ -112,7 +111,7 @@ def mjcf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
         if j is not None:
             a = j.articulation
             kind = "hinge" if a.joint_type == "revolute" else "slide"
-            lines.append(f'{indent}  <joint name="{j.name}" type="{kind}" pos="0 0 0" axis="{_v(a.axis)}" range="{_f(a.lower)} {_f(a.upper)}"/>')
+            lines.append(f'{indent}  <joint name="{j.name}" type="{kind}" pos="0 0 0" axis="{_v(a.axis)}" range="{_f(a.lower)} {_f(a.upper)}" damping="{_f(j.damping)}"/>')
         lines += _geoms(link, files[link.name], indent + "  ")
         for c in children.get(link.name, []):
             lines += body(c, link.frame, indent + "  ")

@@ -66,6 +66,7 @@ class Joint:
     parent: str
     child: str
     articulation: Articulation
+    damping: float = 0.0  # N s/m or N m s/rad (``joint_damping_for``)
 
 
 @dataclass
@@ -128,14 +129,51 @@ TERRITORY_BOX_MAX_LOSS = 0.9
 stays whole; one it crosses (a side wall of a box turned towards its neighbour) is cut."""
 
 
+TERRITORY_WALL_SHIFT_M = 0.05
+"""How far a carcass wall lying wholly on a neighbour's side of the territory plane is moved back to its own
+side (m); one further away is left to be dropped."""
+
+
+def shift_walls(base: list[ConvexPiece], m: np.ndarray, c: float, max_shift: float = TERRITORY_WALL_SHIFT_M) -> list[ConvexPiece]:
+    """Carcass walls lying wholly past the plane m . x = c, within ``max_shift`` of it, moved along -m until
+    their far face lies on it. Two estimated carcasses stacked or side by side interleave (a cupboard's
+    floor a few cm below the drawer box's roof beneath it): cutting each to its side drops both of those
+    walls and leaves one open space through both cavities; moved, each keeps its own wall at the
+    boundary. Walls the plane crosses are left to the cut."""
+    out = []
+    for p in base:
+        s = p.vertices @ m
+        lo = float(s.min())
+        if c < lo <= c + max_shift:
+            shift = float(s.max()) - c
+            p = ConvexPiece(p.vertices - shift * m, p.faces, p.source,
+                            None if p.box is None else np.concatenate([p.box[:3] - shift * m, p.box[3:]]))
+        out.append(p)
+    return out
+
+
+TERRITORY_FRONT_OVERLAP_MAX = 0.1
+"""Two fronts of which one reaches past the territory plane by more than this share of its extent across it
+overlap (a duplicate detection): the plane is no partition between them, so no carcass wall is moved onto it."""
+
+
+def fronts_apart(sa: np.ndarray, sb: np.ndarray, c: float, overlap_max: float = TERRITORY_FRONT_OVERLAP_MAX) -> bool:
+    """Whether the plane at ``c`` parts two fronts, given their vertices' positions ``sa`` / ``sb`` along its
+    normal (A's side below ``c``): each reaches past it by at most ``overlap_max`` of its own extent."""
+    over_a = max(0.0, float(sa.max()) - c) / max(float(np.ptp(sa)), 1e-9)
+    over_b = max(0.0, c - float(sb.min())) / max(float(np.ptp(sb)), 1e-9)
+    return max(over_a, over_b) <= overlap_max
+
+
 def split_territories(objects: list[_Object], margin: float, box_max_loss: float) -> int:
     """Neighbours whose pieces (front, drawer box, carcass) meet are each cut back to their own side
     of a plane between their fronts (``clearance.territory_plane``), ``margin / 2`` off it: two
     carcasses estimated at an angle, or a drawer box reaching behind its neighbour, then share the
     disputed space instead of both claiming it. A drawer-box piece that would lose more than
     ``box_max_loss`` of itself stays whole (a drawer's bottom a few mm below the plane, where its
-    neighbour's front overlaps its own): ``clear_paths`` then cuts whichever of the two loses less.
-    Returns the number of pieces cut."""
+    neighbour's front overlaps its own): ``clear_paths`` then cuts whichever of the two loses less. A
+    carcass wall wholly on the neighbour's side is moved back onto the plane (``shift_walls``) when the
+    plane parts the two fronts (``fronts_apart``). Returns the number of pieces cut."""
     cut = 0
     for i, a in enumerate(objects):
         for b in objects[i + 1 :]:
@@ -145,15 +183,24 @@ def split_territories(objects: list[_Object], margin: float, box_max_loss: float
             fb = np.vstack([p.vertices for p in b.part[: b.n_front]])
             m, c = territory_plane(fa, np.asarray(a.obj.front_normal), fb, np.asarray(b.obj.front_normal),
                                    axes=np.vstack([np.asarray(a.obj.obb.axes, float), np.asarray(b.obj.obb.axes, float)]))
+            apart = fronts_apart(fa @ m, fb @ m, c)
             for o, (mm, cc) in ((a, (m, c - margin / 2)), (b, (-m, -c - margin / 2))):
                 front, k1 = keep_side(o.part[: o.n_front], mm, cc)
                 inner, k2 = keep_side(o.part[o.n_front :], mm, cc, max_loss=box_max_loss)
                 o.part, o.n_front = front + inner, len(front)
                 if o.base is not None:
-                    o.base, k3 = keep_side(o.base, mm, cc)
+                    o.base, k3 = keep_side(shift_walls(o.base, mm, cc) if apart else o.base, mm, cc)
                     k2 += k3
                 cut += k1 + k2
     return cut
+
+
+def joint_damping_for(inertia: float, config: ExportConfig) -> float:
+    """The joint's damping: ``joint_damping``, but never more than ``joint_damping_max_rate`` times what
+    the joint moves (its mass or moment about the hinge). A fixed damping on a light part (a small flap
+    or a fragment at the minimum mass) stalls any drive scaled to its inertia, and an explicit integrator
+    (PyBullet) blows up once ``damping * dt / inertia`` exceeds 2."""
+    return float(min(config.joint_damping, config.joint_damping_max_rate * max(inertia, 0.0)))
 
 
 def obstacle_digest(obstacles: list[Obstacle]) -> str:
@@ -290,11 +337,13 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
             parent = names["base"]
         else:
             parent = "background"
+        inertial = inertial_from_pieces(o.part, config.density_kg_m3, config.min_mass_kg)
         links.append(
             Link(
                 names["part"], np.asarray(art.origin, float), [bake_texture(m, config) for m in o.part_meshes], o.part,
-                inertial=inertial_from_pieces(o.part, config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="part",
+                inertial=inertial, object_id=obj.object_id, role="part",
             )
         )
-        joints.append(Joint(names["joint"], obj.object_id, parent, names["part"], art))
+        damping = joint_damping_for(inertial.about_joint(art.joint_type, np.asarray(art.axis, float), np.asarray(art.origin, float)), config)
+        joints.append(Joint(names["joint"], obj.object_id, parent, names["part"], art, damping))
     return SceneModel(safe_name(scene.scene_id), links, joints, stats)

@@ -63,7 +63,9 @@ def _box(piece: ConvexPiece, frame: np.ndarray) -> tuple[str, str, str]:
 POLICY = (
     "<!-- Collision policy: colliders are separated at rest and around every part's path. Load with self-collision on and "
     "parent exclusion (PyBullet: URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_EXCLUDE_PARENT; SAPIEN/PhysX do this by "
-    "default) so a part never collides with its own carcass (its parent link) and collides with everything else. -->"
+    "default) so a part never collides with its own carcass (its parent link) and collides with everything else. Colliders are "
+    "a few mm apart: in PyBullet set contactBreakingThreshold below that gap (setPhysicsEngineParameter, e.g. 0.002), or "
+    "contact points kept from 2 cm away jam a part sliding past its neighbour. -->"
 )
 
 
@@ -117,7 +119,7 @@ def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
             f'    <origin xyz="{_v(child.frame - parent.frame)}" rpy="0 0 0"/>',
             f'    <axis xyz="{_v(a.axis)}"/>',
             f'    <limit lower="{_f(a.lower)}" upper="{_f(a.upper)}" effort="{_f(config.joint_effort)}" velocity="{_f(config.joint_velocity)}"/>',
-            f'    <dynamics damping="{_f(config.joint_damping)}" friction="0"/>',
+            f'    <dynamics damping="{_f(j.damping)}" friction="0"/>',
             "  </joint>",
         ]
     out.append("</robot>")

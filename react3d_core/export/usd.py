@@ -269,11 +269,11 @@ def write_usd(model: SceneModel, path: str | Path, config: ExportConfig, files: 
         scale = 180.0 / math.pi if revolute else 1.0
         joint.CreateLowerLimitAttr(float(a.lower * scale))
         joint.CreateUpperLimitAttr(float(a.upper * scale))
-        if config.joint_damping > 0:
+        if j.damping > 0:
             drive = UsdPhysics.DriveAPI.Apply(joint.GetPrim(), "angular" if revolute else "linear")
             drive.CreateTypeAttr("force")
             drive.CreateStiffnessAttr(0.0)
-            drive.CreateDampingAttr(float(config.joint_damping / scale))  # per degree for revolute
+            drive.CreateDampingAttr(float(j.damping / scale))  # per degree for revolute
             drive.CreateMaxForceAttr(float(config.joint_effort))
     # a .usdc path is the stage itself; a .usda path is the root over a crate (binary) or the stage (ASCII)
     data = path.with_suffix(".usdc") if config.usd_binary else path

@@ -57,7 +57,7 @@ def _make(engine: str, path: Path, cfg: PhysicsConfig) -> Sim:
     if engine == "pybullet":
         from .pybullet_sim import PybulletSim
 
-        return PybulletSim(path, cfg.timestep)
+        return PybulletSim(path, cfg.timestep, cfg.pybullet_contact_breaking_m)
     from .sapien_sim import SapienSim
 
     return SapienSim(path, cfg.timestep)

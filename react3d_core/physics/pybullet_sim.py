@@ -22,7 +22,7 @@ G = 9.81
 class PybulletSim(Sim):
     engine = "pybullet"
 
-    def __init__(self, urdf: str | Path, timestep: float) -> None:
+    def __init__(self, urdf: str | Path, timestep: float, contact_breaking: float = 0.002) -> None:
         import pybullet as pb
 
         self.pb = pb
@@ -30,6 +30,9 @@ class PybulletSim(Sim):
         self.cid = cid = pb.connect(pb.DIRECT)
         try:
             pb.setTimeStep(timestep, physicsClientId=cid)
+            # Bullet keeps contact points up to this far apart; at its default (0.02 m) a point found where a part
+            # slides 5 mm past a neighbour keeps its first normal as it slides, and blocks the part
+            pb.setPhysicsEngineParameter(contactBreakingThreshold=float(contact_breaking), physicsClientId=cid)
             pb.setGravity(0, 0, -G, physicsClientId=cid)
             flags = pb.URDF_USE_SELF_COLLISION | pb.URDF_USE_INERTIA_FROM_FILE
             self.body = body = pb.loadURDF(str(urdf), useFixedBase=True, flags=flags, physicsClientId=cid)
@@ -41,6 +44,7 @@ class PybulletSim(Sim):
         self.settings = {"file": "URDF", "timestep": self.dt, "fixed_base": True,
                          "self_collision": "on, parent-child pairs excluded (URDF_USE_SELF_COLLISION); pairs of links that never move skipped",
                          "solver_iterations": int(params.get("numSolverIterations", 0)), "gravity": [0, 0, -G],
+                         "contact_breaking_threshold": float(contact_breaking),
                          "drive": "PD as joint torques (TORQUE_CONTROL), default motors off"}
         n = pb.getNumJoints(body, physicsClientId=cid)
         infos = [pb.getJointInfo(body, i, physicsClientId=cid) for i in range(n)]

@@ -223,3 +223,29 @@ def test_keep_side_leaves_a_piece_that_would_lose_too_much() -> None:
     wall = cube((0, 0, 0.3), (0.5, 0.005, 0.5))  # loses 0.021 / 0.2 = 10.5 %: cut
     (cut,), n = keep_side([wall], m, c, max_loss=0.3)
     assert n == 1 and cut.vertices[:, 2].min() == pytest.approx(0.321)
+
+
+def test_interleaved_carcass_walls_are_moved_to_their_side_not_dropped():
+    from react3d_core.export.model import shift_walls
+
+    # a cupboard above a drawer; its carcass keeps z >= 0.48 (m = -z, c = -0.48). Its floor was estimated
+    # at z 0.45..0.475, wholly below: moved up by 0.48 - 0.45 = 0.03 to z 0.48..0.505, so its cavity stays closed
+    m, c = np.array([0.0, 0.0, -1.0]), -0.48
+    floor = cube([0.0, 0.0, 0.45], [0.4, 0.5, 0.475])
+    far = cube([0.0, 0.0, 0.30], [0.4, 0.5, 0.32])  # 16 cm past: not a wall of this carcass's boundary
+    side = cube([0.0, 0.0, 0.45], [0.02, 0.5, 1.2])  # crossed by the plane: left to the cut
+    out = shift_walls([floor, far, side], m, c)
+    np.testing.assert_allclose(out[0].vertices.min(0), [0.0, 0.0, 0.48], atol=1e-12)
+    np.testing.assert_allclose(out[0].vertices.max(0), [0.4, 0.5, 0.505], atol=1e-12)
+    assert out[1] is far and out[2] is side
+    kept, _ = keep_side(out, m, c)
+    assert len(kept) == 2  # the moved floor and the cut side; the far plate is dropped
+
+
+def test_fronts_apart_only_when_the_plane_parts_them():
+    from react3d_core.export.model import fronts_apart
+
+    # stacked fronts, plane at 0.48: a drawer below, a 1.66 m door above reaching 3.1 cm below it (1.9 %): apart
+    assert fronts_apart(np.array([0.052, 0.478]), np.array([0.449, 2.107]), 0.48)
+    # a 0.117 m fragment with half of its width past the plane (a duplicate of its neighbour): not apart
+    assert not fronts_apart(np.array([2.644, 2.761]), np.array([2.64, 3.14]), 2.70)

@@ -8,7 +8,9 @@ import trimesh
 
 from react3d_core.data import TriMesh
 from react3d_core.export.collision import convex_piece, convex_pieces, planar_patches
-from react3d_core.export.inertia import combine, inertial_from_pieces, principal
+from react3d_core.config.export import ExportConfig
+from react3d_core.export.inertia import Inertial, combine, inertial_from_pieces, principal
+from react3d_core.export.model import joint_damping_for
 
 
 def tm(m: trimesh.Trimesh) -> TriMesh:
@@ -85,3 +87,18 @@ def test_planar_patches_split_floor_and_wall() -> None:
     patches = planar_patches(tm(trimesh.util.concatenate([floor, wall])), cell=2.0, min_thickness=0.01)
     assert len(patches) == 2  # one slab each, never the solid corner wedge
     assert all(p.volume == pytest.approx(0.01) for p in patches)
+
+
+def test_about_joint_is_mass_or_moment_about_the_hinge_line():
+    # a 2 kg body, COM 0.3 m from a vertical hinge line, moment 0.05 about the vertical through its COM
+    inn = Inertial(2.0, np.array([1.3, 0.0, 0.5]), np.array([0.05, 0.2, 0.3]), np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]))
+    assert inn.about_joint("prismatic", np.array([1.0, 0, 0]), np.zeros(3)) == 2.0
+    # the principal axis of moment 0.05 is world -z, so the moment about z is 0.05; plus m d^2 = 2 * 0.3^2
+    assert inn.about_joint("revolute", np.array([0, 0, -1.0]), np.array([1.0, 0.0, 7.0])) == pytest.approx(0.05 + 0.18)
+
+
+def test_joint_damping_is_capped_by_what_the_joint_moves():
+    cfg = ExportConfig(joint_damping=1.0, joint_damping_max_rate=10.0)
+    assert joint_damping_for(0.4, cfg) == 1.0  # a door: 10 * 0.4 = 4 > 1
+    assert joint_damping_for(1e-4, cfg) == pytest.approx(1e-3)  # a 0.1 kg sliver near its hinge
+    assert joint_damping_for(2.0, ExportConfig(joint_damping=0.0)) == 0.0
