@@ -14,6 +14,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+import trimesh
+from scipy.spatial import QhullError
 
 from ..config.export import ExportConfig
 from ..data.mesh import TriMesh, load_mesh
@@ -212,6 +214,24 @@ def obstacle_digest(obstacles: list[Obstacle]) -> str:
     return h.hexdigest()[:16]
 
 
+def _body_inertial(pieces: list[ConvexPiece], meshes: list[TriMesh], config: ExportConfig, stats: dict) -> Inertial:
+    """The body's inertial from its collision pieces; a body whose pieces were all cut away to keep it
+    clear of its neighbours (a carcass lying inside another, a duplicate front) gets it from the convex
+    hull of what it shows, so the export is still complete, and is counted in ``bodies_without_colliders``
+    (the physics check then reports what it fails to block)."""
+    if pieces:
+        return inertial_from_pieces(pieces, config.density_kg_m3, config.min_mass_kg)
+    stats["bodies_without_colliders"] = stats.get("bodies_without_colliders", 0) + 1  # visible in the manifest
+    points = np.vstack([m.vertices for m in meshes if m is not None and len(m.vertices)] or [np.zeros((0, 3))])
+    try:
+        hull = trimesh.Trimesh(points, process=False).convex_hull
+        return inertial_from_pieces([ConvexPiece(np.asarray(hull.vertices), np.asarray(hull.faces), "hull")],
+                                    config.density_kg_m3, config.min_mass_kg)
+    except (ValueError, IndexError, QhullError):  # flat or empty: a point mass at what it shows
+        centre = points.mean(0) if len(points) else np.zeros(3)
+        return Inertial(config.min_mass_kg, centre, np.full(3, 1e-6), np.eye(3))
+
+
 def separate_colliders(objects: list[_Object], config: ExportConfig
                        ) -> tuple[list[Obstacle], list[Obstacle], list[Obstacle], dict[str, float]]:
     """Cut part and carcass pieces back so that no pair overlaps at rest and nothing static stands in a
@@ -225,7 +245,7 @@ def separate_colliders(objects: list[_Object], config: ExportConfig
     volume is made, up to ``part_trim_max_fraction`` of a piece (``clearance.clear_paths``); deeper
     conflicts are left to the joint limits."""
     m = config.collider_clearance_m
-    stats = {"parts_cut": 0, "carcass_cut": 0, "pieces_dropped": 0, "part_conflicts_left": 0}
+    stats = {"parts_cut": 0, "carcass_cut": 0, "pieces_dropped": 0, "part_conflicts_left": 0, "bodies_without_colliders": 0}
     stats["territory_cut"] = split_territories(objects, m, TERRITORY_BOX_MAX_LOSS)
     parts, st = separate_at_rest([o.part for o in objects], m)
     stats["parts_cut"] += st.cut
@@ -331,13 +351,13 @@ def build_scene_model(scene: InteractiveScene, root: str | Path, config: ExportC
             links.append(
                 Link(
                     names["base"], np.zeros(3), [bake_texture(o.base_mesh, config)], o.base or [],
-                    inertial=inertial_from_pieces(o.base or [], config.density_kg_m3, config.min_mass_kg), object_id=obj.object_id, role="base",
+                    inertial=_body_inertial(o.base or [], [o.base_mesh], config, stats), object_id=obj.object_id, role="base",
                 )
             )
             parent = names["base"]
         else:
             parent = "background"
-        inertial = inertial_from_pieces(o.part, config.density_kg_m3, config.min_mass_kg)
+        inertial = _body_inertial(o.part, o.part_meshes, config, stats)
         links.append(
             Link(
                 names["part"], np.asarray(art.origin, float), [bake_texture(m, config) for m in o.part_meshes], o.part,

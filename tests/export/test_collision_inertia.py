@@ -102,3 +102,25 @@ def test_joint_damping_is_capped_by_what_the_joint_moves():
     assert joint_damping_for(0.4, cfg) == 1.0  # a door: 10 * 0.4 = 4 > 1
     assert joint_damping_for(1e-4, cfg) == pytest.approx(1e-3)  # a 0.1 kg sliver near its hinge
     assert joint_damping_for(2.0, ExportConfig(joint_damping=0.0)) == 0.0
+
+
+def test_a_body_whose_colliders_were_all_cut_away_gets_its_inertial_from_what_it_shows() -> None:
+    """A carcass lying inside another loses every piece to the clearance; the export must still
+    complete. 0.4 x 0.5 x 0.6 m box at (1, 2, 3): volume 0.12 m^3, centre of mass at its centre."""
+    import trimesh
+
+    from react3d_core.config.export import ExportConfig
+    from react3d_core.data.mesh import TriMesh
+    from react3d_core.export.model import _body_inertial
+
+    box = trimesh.creation.box(extents=(0.4, 0.5, 0.6)).apply_translation((1.0, 2.0, 3.0))
+    cfg = ExportConfig()
+    stats: dict = {}
+    inertial = _body_inertial([], [TriMesh(box.vertices, box.faces)], cfg, stats)
+    assert stats == {"bodies_without_colliders": 1}
+    assert inertial.mass == pytest.approx(max(0.12 * cfg.density_kg_m3, cfg.min_mass_kg))
+    assert np.allclose(inertial.com, (1.0, 2.0, 3.0))
+    flat = TriMesh(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float), np.array([[0, 1, 2]]))
+    point = _body_inertial([], [flat], cfg, stats)  # no volume: a point mass at what it shows
+    assert stats["bodies_without_colliders"] == 2 and point.mass == cfg.min_mass_kg
+    assert np.allclose(point.com, (1 / 3, 1 / 3, 0))
