@@ -294,6 +294,10 @@ def _file_sha256(path: Path) -> str:
     return h.hexdigest()
 
 
+POINTER_READS = 3  # reads of a pointer that does not parse before it is called unreadable
+POINTER_RETRY_S = 0.2
+
+
 def _pointer_prefix(fs: Any, path: str) -> str | None:
     """The prefix the current pointer names (None: no readable pointer)."""
     try:
@@ -309,17 +313,22 @@ def read_pointer(url: str) -> dict[str, Any]:
     has not finished), unreadable, or does not match the objects under its prefix."""
     url = url.rstrip("/")
     fs, path = filesystem(url)
-    try:
-        raw = fs.cat_file(f"{path}/{OUTPUT_POINTER}")
-    except FileNotFoundError:
-        raise InputError(url, f"has no {OUTPUT_POINTER}: not a published react3d output, or its publication "
-                              "has not finished") from None
-    try:
-        pointer = json.loads(raw)
-        prefix = str(pointer["prefix"]).strip("/")
-        files = {str(k): {"size": int(v["size"]), "sha256": str(v["sha256"])} for k, v in pointer["files"].items()}
-    except (ValueError, KeyError, TypeError, AttributeError):
-        raise InputError(f"{url}/{OUTPUT_POINTER}", "is not a readable react3d output pointer") from None
+    for attempt in range(POINTER_READS):
+        try:
+            raw = fs.cat_file(f"{path}/{OUTPUT_POINTER}")
+        except FileNotFoundError:
+            raise InputError(url, f"has no {OUTPUT_POINTER}: not a published react3d output, or its publication "
+                                  "has not finished") from None
+        try:
+            pointer = json.loads(raw)
+            prefix = str(pointer["prefix"]).strip("/")
+            files = {str(k): {"size": int(v["size"]), "sha256": str(v["sha256"])} for k, v in pointer["files"].items()}
+            break
+        except (ValueError, KeyError, TypeError, AttributeError):
+            # a store whose writes are not atomic (a file-backed S3 server) can be read mid-replacement
+            if attempt == POINTER_READS - 1:
+                raise InputError(f"{url}/{OUTPUT_POINTER}", "is not a readable react3d output pointer") from None
+            time.sleep(POINTER_RETRY_S)
     if not prefix.startswith(f"{VERSIONS_DIR}/") or ".." in prefix.split("/") or \
             any(".." in k.split("/") or k.startswith("/") for k in files) or "scene.json" not in files:
         raise InputError(f"{url}/{OUTPUT_POINTER}", "names files outside its output; refusing it")
