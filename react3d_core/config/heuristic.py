@@ -164,7 +164,7 @@ class PlanesConfig(StageConfig):
     refit_step_deg: float = Field(0.1, gt=0, description="Directions tried by the refit are this far apart (deg).")
     refit_bin: float = Field(0.002, gt=0, description="The refit's offset density: bins of this size (m) ...")
     refit_sigma: float = Field(0.003, gt=0, description="... smoothed by a Gaussian of this sigma (m).")
-    max_skew_deg: float = Field(5.0, ge=0, description="A plane piece whose faces' positions lie on a line turned from its own direction by more than this (deg, least squares over the piece), with their normals leaning the same way, is a slice through a surface at another angle (a turned cabinet's front cut along a wall's direction), not a plane; its faces vote again (0: no such test).")
+    max_skew_deg: float = Field(5.0, ge=0, description="A plane piece whose faces' normals are turned from its own normal by more than this on average (area-weighted, deg) is a slice through a surface at another angle (a turned cabinet's front cut along a wall's direction), not a plane; its faces vote again (0: no such test).")
     revote_rounds: int = Field(1, ge=0, description="Rounds in which the vertical faces no plane holds vote again for directions at least direction_min_sep_bins from those found (a piece of furniture turned by ~10 degrees is hidden in the first vote by the walls' peak; 0: one vote).")
     min_area: float = Field(0.08, ge=0, description="Smallest vertical plane photographed (m^2; at least fronts.min_w x fronts.min_h).")
     cell: float = Field(0.04, gt=0, description="Pieces of one plane farther apart than this are separate planes (m).")
