@@ -164,8 +164,6 @@ class PlanesConfig(StageConfig):
     refit_step_deg: float = Field(0.1, gt=0, description="Directions tried by the refit are this far apart (deg).")
     refit_bin: float = Field(0.002, gt=0, description="The refit's offset density: bins of this size (m) ...")
     refit_sigma: float = Field(0.003, gt=0, description="... smoothed by a Gaussian of this sigma (m).")
-    max_skew_deg: float = Field(5.0, ge=0, description="A plane piece whose faces' normals are turned from its own normal by more than this on average (area-weighted, deg) is a slice through a surface at another angle (a turned cabinet's front cut along a wall's direction), not a plane; its faces vote again (0: no such test).")
-    revote_rounds: int = Field(1, ge=0, description="Rounds in which the vertical faces no plane holds vote again for directions at least direction_min_sep_bins from those found (a piece of furniture turned by ~10 degrees is hidden in the first vote by the walls' peak; 0: one vote).")
     min_area: float = Field(0.08, ge=0, description="Smallest vertical plane photographed (m^2; at least fronts.min_w x fronts.min_h).")
     cell: float = Field(0.04, gt=0, description="Pieces of one plane farther apart than this are separate planes (m).")
     min_fragment_area: float = Field(0.03, ge=0, description="Fragments of a plane's coverage smaller than this are not part of it (m^2).")
@@ -300,7 +298,6 @@ class CellConfig(StageConfig):
     min_seen: float = Field(0.55, ge=0, le=1, description="Share of a cell the plane's faces must cover.")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
     handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")
-    stack_min: int = Field(3, ge=0, description="A handle-less cell in a column of at least this many door/drawer-sized cells stacked on one another, each as wide as the next (a drawer pedestal or chest with edge pulls or no handles), is a front; 0: off.")
 
 
 class ClutterConfig(StageConfig):

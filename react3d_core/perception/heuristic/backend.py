@@ -81,7 +81,7 @@ class HeuristicModel:
             if h.lines.enabled and line_detector is None:
                 line_detector = load_line_detector(h.lines)
             self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, h, taken, self.fronts,
-                                           line_detector, view_dirs[self.facets.labels])
+                                           line_detector)
             self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
         if h.splashback.enabled:  # fronts flush with the wall right above a worktop are splash-back
             self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, h.splashback)) if not drop]

@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from ...config.heuristic import FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig
+from ...config.heuristic import FloorConfig, HandleConfig, HeuristicConfig, ImageConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
@@ -264,18 +264,15 @@ def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[in
 def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, read_rgb: Callable[[Frame], np.ndarray],
                       cfg: HeuristicConfig = HeuristicConfig(), taken_faces: np.ndarray | None = None,
                       mesh_fronts: Sequence[Front] = (),
-                      detect_lines: Callable[[np.ndarray], np.ndarray] | None = None,
-                      view_dirs: np.ndarray | None = None) -> ImageFronts:
+                      detect_lines: Callable[[np.ndarray], np.ndarray] | None = None) -> ImageFronts:
     """Fronts from the colour frames (see module docstring), by the rules of ``cfg``. ``taken_faces``
     (bool per face) are faces of fronts already found on the mesh: cells overlapping them are left to
     the mesh rules. ``detect_lines`` (an RGB image -> its line segments (N, 4+: x0, y0, x1, y1 px)) gives
-    learned seam evidence when ``lines.enabled`` (line_evidence.py). ``view_dirs`` (per face, the summed
-    directions towards the cameras that saw it) turns each plane towards the cameras that see it; without
-    it, towards the cameras' mean position, which for a piece standing free in the room may lie behind it."""
+    learned seam evidence when ``lines.enabled`` (line_evidence.py)."""
     rules, hc, clut = cfg.fronts, cfg.handles, cfg.clutter
     cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, XYZ))
     planes = vertical_planes(mesh, cams.mean(0), cfg.planes, max_tilt=rules.max_tilt,
-                             min_area=max(cfg.planes.min_area, rules.min_w * rules.min_h), view_dirs=view_dirs)
+                             min_area=max(cfg.planes.min_area, rules.min_w * rules.min_h))
     orthos, calib, per_view = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, cfg.ortho,
                                                 cfg.calibration, cfg.registration)
     supports: list[LineSupport] = []
@@ -331,11 +328,9 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                     gridded.add(id(f))
     fronts, split_mesh = _settle_with_mesh_fronts(fronts, taken_faces, mesh_fronts, mesh.n_faces, cfg.image)
     # a handle-less cell is a front beside a front with a handle, or when straight seams along its whole
-    # length cut it out on ``handleless_min_seams`` sides (push-to-open fronts), or in a column of
-    # ``stack_min`` stacked cells of one width (a drawer pedestal with edge pulls); tiles and splash-backs
+    # length cut it out on ``handleless_min_seams`` sides (push-to-open fronts); tiles and splash-backs
     # have no handles and, tiled, cells smaller than a front
-    stacked = stacks(fronts, rules, cfg.cells.stack_min)
-    fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded or id(f) in stacked
+    fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded
               or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
     # ... but a handle-less panel that reaches down to the floor is wall (beside a room door, say): base
     # units stand on a plinth and room doors have handles
@@ -347,33 +342,6 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, cfg)})
     return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
-
-
-def stacks(fronts: list[Front], rules: FrontRulesConfig, n: int) -> set[int]:
-    """Ids of the fronts in a column of at least ``n`` (0: none) fronts stacked one on another, each of
-    the same width as the next and touching it (``_neighbours`` above/below): a drawer pedestal, a chest
-    or a filing cabinet whose drawers have edge pulls or none. A wall is not cut into such a column of
-    drawer-sized cells; its cells are wall-wide or door-tall."""
-    if n <= 0:
-        return set()
-    col = {id(f): [g for g, side in _neighbours(f, fronts, rules) if side == "vertical"] for f in fronts}
-    out: set[int] = set()
-    seen: set[int] = set()
-    for f in fronts:
-        if id(f) in seen:
-            continue
-        group, todo = [], [f]
-        seen.add(id(f))
-        while todo:
-            g = todo.pop()
-            group.append(g)
-            for h in col[id(g)]:
-                if id(h) not in seen:
-                    seen.add(id(h))
-                    todo.append(h)
-        if len(group) >= n:
-            out.update(id(g) for g in group)
-    return out
 
 
 def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.ndarray | None:
