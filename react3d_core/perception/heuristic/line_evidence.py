@@ -24,7 +24,7 @@ from ...data.frames import Frame
 from ...raster import Rasterizer
 from .colour_sampling import ColourCalibration
 from .constants import REFERENCE_WIDTH_PX
-from .orthophoto import Orthophoto
+from .orthophoto import Orthophoto, project_into_views
 
 _NEAR = 0.1  # m: plane points closer to the camera than this are at or behind it
 _SAMPLES_PER_PX = 2  # a segment is followed at half a grid pixel on the plane ...
@@ -192,12 +192,7 @@ def pick_line_views(orthos: Sequence[Orthophoto], frames: Sequence[Frame], p: Li
         H, W = o.n_views.shape
         cols, rows = np.meshgrid(np.linspace(0, W - 1, _PICK_GRID), np.linspace(0, H - 1, _PICK_GRID))
         sample = o.plane.to_world(*o.to_uv(cols.ravel(), rows.ravel()))
-        pc = np.einsum("fij,sj->fsi", w2cs[:, :3, :3], sample) + w2cs[:, None, :3, 3]
-        z = pc[..., 2]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = Ks[:, None, 0, 0] * pc[..., 0] / z + Ks[:, None, 0, 2]
-            y = Ks[:, None, 1, 1] * pc[..., 1] / z + Ks[:, None, 1, 2]
-        inside = (z > _NEAR) & (x >= 0) & (x < size[:, None, 0]) & (y >= 0) & (y < size[:, None, 1])
+        inside = project_into_views(sample, w2cs, Ks, size)[3]
         ray = sample[None] - centers[:, None]
         cos = -(ray @ o.plane.n) / np.maximum(np.linalg.norm(ray, axis=-1), 1e-9)
         score = (cos * (inside & (cos >= ortho.min_cos))).sum(1)

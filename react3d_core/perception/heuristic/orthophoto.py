@@ -343,6 +343,20 @@ def _away_from_edges(depth: np.ndarray, px: int, jump: float, edge: np.ndarray |
     return ~edge
 
 
+def project_into_views(points: np.ndarray, w2cs: np.ndarray, Ks: np.ndarray, size: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Pixel coordinates ``x``, ``y`` and depth ``z`` (F, S) of world ``points`` (S, 3) in F pinhole views
+    (world-to-camera ``w2cs`` (F, 4, 4), intrinsics ``Ks`` (F, 3, 3), image ``size`` (F, 2) as w, h), and
+    whether each lies in front of the camera (beyond ``_NEAR``) and inside its image."""
+    pc = np.einsum("fij,sj->fsi", w2cs[:, :3, :3], points) + w2cs[:, None, :3, 3]
+    z = pc[..., 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = Ks[:, None, 0, 0] * pc[..., 0] / z + Ks[:, None, 0, 2]
+        y = Ks[:, None, 1, 1] * pc[..., 1] / z + Ks[:, None, 1, 2]
+    inside = (z > _NEAR) & (x >= 0) & (x < size[:, None, 0]) & (y >= 0) & (y < size[:, None, 1])
+    return x, y, z, inside
+
+
 def _pick_views(planes: Sequence[Plane], frames: Sequence[Frame], grids: list[np.ndarray], p: OrthoConfig) -> list[set[int]]:
     """Per plane, up to ``max_views`` frames chosen for coverage, sharpness and diversity, on a
     ``pick_samples`` x ``pick_samples`` sample of the plane: each sample wants ``pick_need`` views; a frame is
@@ -364,12 +378,7 @@ def _pick_views(planes: Sequence[Plane], frames: Sequence[Frame], grids: list[np
         h, w = pts.shape[:2]
         k = p.pick_samples if p.pick_spread else _BEST_GRID
         sample = pts[np.ix_(np.linspace(0, h - 1, k).astype(int), np.linspace(0, w - 1, k).astype(int))].reshape(-1, pts.shape[-1])
-        pc = np.einsum("fij,sj->fsi", w2cs[:, :3, :3], sample) + w2cs[:, None, :3, 3]
-        z = pc[..., 2]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            x = Ks[:, None, 0, 0] * pc[..., 0] / z + Ks[:, None, 0, 2]
-            y = Ks[:, None, 1, 1] * pc[..., 1] / z + Ks[:, None, 1, 2]
-        inside = (z > _NEAR) & (x >= 0) & (x < size[:, None, 0]) & (y >= 0) & (y < size[:, None, 1])
+        x, y, z, inside = project_into_views(sample, w2cs, Ks, size)
         ray = sample[None] - centers[:, None]
         dist = np.maximum(np.linalg.norm(ray, axis=-1), _NEAR)
         cos = -(ray @ pl.n) / dist
