@@ -189,21 +189,14 @@ def protrusion_from_faces(o: Orthophoto, centroids: np.ndarray, normals: np.ndar
     plane in places, and its bumps there are no handles."""
     h, w = o.n_views.shape
     p = o.plane
-    depth, block = hc.protrusion_depth, hc.surface_block
+    depth = hc.protrusion_depth
     dn = centroids @ p.n - p.d
     # outward faces that can stand out: against the plane, from depth[0]; against the surface, from behind it
     cand = np.flatnonzero((dn > (-behind if win > 0 else depth[0])) & (dn < depth[1]) & (normals @ p.n > hc.protrusion_min_cos))
     c = np.floor((centroids[cand] @ p.u - o.u0) / o.res).astype(int)
     r = np.floor((o.v_top - centroids[cand, 2]) / o.res).astype(int)
     ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
-    dn, r, c = dn[cand][ok], r[ok], c[ok]
-    if win > 0:
-        dn = dn - _local_surface(dn, r, c, (h, w), max(1, int(round(block / o.res))), win / block)[r, c]
-    sel = (dn > depth[0]) & (dn < depth[1])
-    out = np.zeros((h, w), np.uint8)
-    out[r[sel], c[sel]] = 1
-    out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((hc.bar_close_px, hc.bar_close_px), np.uint8))
-    return cv2.dilate(out, NEIGHBOURS).astype(bool)
+    return _protruding(dn[cand][ok], r[ok], c[ok], o, hc, win)
 
 
 def protrusion_map(o: Orthophoto, surf: PlaneSurface, hc: HandleConfig, win: float, behind: float) -> np.ndarray:
@@ -215,14 +208,20 @@ def protrusion_map(o: Orthophoto, surf: PlaneSurface, hc: HandleConfig, win: flo
     around it instead: the median offset of the surface within ``win`` (``hc.surface_block`` blocks, each
     its pixels' median), from ``behind`` the plane on. A TSDF wall lies a centimetre or two off its fitted
     plane in places, and its bumps there are no handles."""
-    h, w = o.n_views.shape
-    depth, block = hc.protrusion_depth, hc.surface_block
+    depth = hc.protrusion_depth
     dn = surf.front
     with np.errstate(invalid="ignore"):
         # outward surface that can stand out: against the plane, from depth[0]; against the surface, from behind it
         cand = (dn > (-behind if win > 0 else depth[0])) & (dn < depth[1]) & (surf.front_cos > hc.protrusion_min_cos)
     r, c = np.nonzero(cand)
-    dn = dn[r, c].astype(np.float64)
+    return _protruding(dn[r, c].astype(np.float64), r, c, o, hc, win)
+
+
+def _protruding(dn: np.ndarray, r: np.ndarray, c: np.ndarray, o: Orthophoto, hc: HandleConfig, win: float) -> np.ndarray:
+    """Grid pixels (rows ``r``, cols ``c``) whose offsets ``dn`` stand ``hc.protrusion_depth`` out, from the
+    plane or (``win`` > 0) from the surface around them, closed over ``hc.bar_close_px`` and grown by 1 px."""
+    h, w = o.n_views.shape
+    depth, block = hc.protrusion_depth, hc.surface_block
     if win > 0:
         dn = dn - _local_surface(dn, r, c, (h, w), max(1, int(round(block / o.res))), win / block)[r, c]
     sel = (dn > depth[0]) & (dn < depth[1])
