@@ -173,11 +173,7 @@ def pull_dir(rel: str, local: Path, seal_suffix: str) -> bool:
             t.parent.mkdir(parents=True, exist_ok=True)
         if files:  # one batched, concurrent download
             fs.get(files, [str(t) for t in targets])
-        try:
-            os.replace(tmp, local)
-        except OSError:  # another thread or process placed it first
-            if not local.is_dir():
-                raise
+        _place(tmp, local)
         return True
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
@@ -385,14 +381,20 @@ def fetch_output(url: str) -> Path:
             if not t.is_file() or _file_sha256(t) != pointer["files"][r]["sha256"]:
                 raise InputError(f"{url}/{pointer['prefix']}/{r}",
                                  f"does not match the sha256 in its {OUTPUT_POINTER}: refusing the output")
-        try:
-            os.replace(tmp, dest)
-        except OSError:  # another process placed the same copy first
-            if not dest.is_dir():
-                raise
+        _place(tmp, dest)
         return dest
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _place(tmp: Path, dest: Path) -> None:
+    """Move a finished download ``tmp`` to ``dest`` in one rename; another thread or process that placed
+    the same content there first wins (content-addressed, so either copy is right)."""
+    try:
+        os.replace(tmp, dest)
+    except OSError:
+        if not dest.is_dir():
+            raise
 
 
 def fetch_outputs(url: str) -> Path:
