@@ -278,3 +278,31 @@ def test_a_scan_larger_than_the_free_disk_is_refused_before_its_download(tmp_pat
     scan_cache.check_free_space(tmp_path, free // 2, "s3://b/scans/s0")
     with pytest.raises(InputError, match=rf"^{tmp_path}: the scan s3://b/scans/s0 is .* GB and this disk has .* GB free"):
         scan_cache.check_free_space(tmp_path, free + 10**9, "s3://b/scans/s0")
+
+
+def test_which_store_errors_are_retried() -> None:
+    """Real exception objects as botocore, s3fs and aiohttp raise them: connection and 5xx errors are
+    retried, refused credentials and missing objects are not, and a refusal raised while cleaning up
+    after a lost connection (s3rver answers 405 to aborting a multipart upload) counts as that lost connection."""
+    import errno
+
+    import aiohttp
+    from botocore.exceptions import ConnectionClosedError, EndpointConnectionError
+
+    from tasks.remote_fs import StoreUnavailableError, _during_lost_connection, is_store_transient
+
+    lost = EndpointConnectionError(endpoint_url="http://127.0.0.1:1/b/k")
+    assert is_store_transient(lost) and is_store_transient(ConnectionClosedError(endpoint_url="http://x"))
+    assert is_store_transient(aiohttp.ServerDisconnectedError()) and is_store_transient(ConnectionRefusedError())
+    assert is_store_transient(OSError(errno.EBUSY, "SlowDown")) and is_store_transient(OSError(errno.EREMOTEIO, "500"))
+    assert not is_store_transient(PermissionError("Forbidden")) and not is_store_transient(FileNotFoundError("k"))
+    assert not is_store_transient(OSError(errno.EINVAL, "bad")) and not is_store_transient(ValueError("x"))
+    assert not is_store_transient(StoreUnavailableError("already retried for the whole budget"))
+    try:
+        try:
+            raise lost
+        except EndpointConnectionError:
+            raise PermissionError("The specified method is not allowed against this resource.")  # noqa: B904
+    except PermissionError as exc:
+        assert _during_lost_connection(exc)
+    assert not _during_lost_connection(PermissionError("The AWS Access Key Id you provided does not exist"))

@@ -288,3 +288,43 @@ def test_flow_run_killed_under_a_living_worker_is_retried(dataset: Path, tmp_pat
     assert runs["s0-attempt1"]["state_type"] == "CRASHED" and "SIGKILL" in runs["s0-attempt1"]["state"]["message"]
     assert runs["s0-attempt2"]["state_type"] == "COMPLETED" and rows["s0"]["retries"] == 1
     assert "Cached" in perceive, perceive  # the batches finished before the kill are not recomputed
+
+
+def test_a_scene_failed_by_a_store_down_past_its_budget_is_submitted_again(dataset: Path, tmp_path: Path) -> None:
+    """The store (S3 server) dies while a scene runs and stays down longer than the worker's retry budget
+    (4 s here): the run fails with the store's one line, the scene is submitted again, and once the store
+    is back the next attempt converts it; the table keeps the first attempt's reason."""
+    if s3rver_command() is None:
+        pytest.skip("s3rver not installed (bash scripts/setup.sh test)")
+    import shutil
+
+    one = tmp_path / "one"
+    one.mkdir()
+    shutil.copytree(dataset / "s0", one / "s0")
+    with S3Server(tmp_path / "s3" / "data") as s3:
+        with LocalCluster(tmp_path / "cluster", n_workers=1, store=s3.url("store"),
+                          extra_env={**s3.env, "REACT3D_STORE_RETRY_SECONDS": "4"}) as c:
+            proc = c.convert_dataset([str(one), "--out", s3.url("out"), *ARGS], wait=False)
+            deadline = time.time() + 600
+            state = ""
+            while state != "RUNNING" and proc.poll() is None and time.time() < deadline:
+                state = {r["name"]: r["state_type"] for r in c.scene_runs()}.get("s0-attempt1", "")
+                time.sleep(0.5)
+            s3.kill()
+            t_down = time.time()
+            while state not in ("FAILED", "COMPLETED", "CRASHED") and proc.poll() is None and time.time() < deadline:
+                state = {r["name"]: r["state_type"] for r in c.scene_runs()}.get("s0-attempt1", "")
+                time.sleep(0.5)
+            s3.start()
+            down_s = time.time() - t_down
+            rc = proc.wait(timeout=900)
+            runs = {r["name"]: r for r in c.scene_runs()}
+            rows = _rows(c)
+            log = (c.home / "convert-dataset.log").read_text(errors="replace")
+    print(f"\nstore down {down_s:.1f} s; rows: {json.dumps(rows, indent=1)}")
+    assert rc == 0, log[-3000:]
+    first = runs["s0-attempt1"]
+    assert first["state_type"] == "FAILED" and "StoreUnavailableError" in first["state"]["message"], first["state"]
+    assert runs["s0-attempt2"]["state_type"] == "COMPLETED"
+    assert rows["s0"]["status"] == "ok" and rows["s0"]["retries"] == 1, rows
+    assert rows["s0"]["error"].startswith("attempt 1 failed: ") and "did not answer" in rows["s0"]["error"], rows
