@@ -87,7 +87,7 @@ def _first_line(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {text.splitlines()[0][:200]}" if text else type(exc).__name__
 
 
-def _remote_name(name: str, args: tuple[Any, ...]) -> str:
+def _remote_name(name: str, args: tuple[Any, ...], scheme: str = "s3") -> str:
     """The object a call is about, as ``s3://...`` (the first of a batch, with the batch size)."""
     first = args[1] if name in _UPLOADS and len(args) > 1 else (args[0] if args else "")
     if isinstance(first, dict):
@@ -96,10 +96,10 @@ def _remote_name(name: str, args: tuple[Any, ...]) -> str:
         n = len(first)
         first = (first[0] if n else "") if n <= 1 else f"{first[0]} (and {n - 1} more)"
     s = str(first)
-    return s if "://" in s else f"s3://{s}"
+    return s if "://" in s else f"{scheme}://{s}"
 
 
-def _local_dir(name: str, args: tuple[Any, ...], kwargs: dict[str, Any]) -> str:
+def _local_dir(args: tuple[Any, ...], kwargs: dict[str, Any]) -> str:
     """The local folder a download writes into (for the disk-full line)."""
     target = kwargs.get("lpath", args[1] if len(args) > 1 else "")
     if isinstance(target, (list, tuple)):
@@ -118,6 +118,8 @@ class ResilientFS:
     def __init__(self, fs: Any, endpoint: str) -> None:
         self._fs = fs
         self.endpoint = endpoint
+        protocol = fs.protocol
+        self.scheme = str(protocol[0] if isinstance(protocol, (tuple, list)) else protocol)
 
     def __getattr__(self, name: str) -> Any:
         attr = getattr(self._fs, name)
@@ -129,6 +131,9 @@ class ResilientFS:
             return self._call(name, attr, args, kwargs)
 
         return call
+
+    def _name(self, name: str, args: tuple[Any, ...]) -> str:
+        return _remote_name(name, args, self.scheme)
 
     def _call(self, name: str, fn: Any, args: tuple[Any, ...], kwargs: dict[str, Any]) -> Any:
         budget = retry_seconds()
@@ -142,14 +147,14 @@ class ResilientFS:
                 raise
             except PermissionError as exc:
                 if not _during_lost_connection(exc):
-                    raise StoreAccessError(_remote_name(name, args), f"the store at {self.endpoint} refused access "
+                    raise StoreAccessError(self._name(name, args), f"the store at {self.endpoint} refused access "
                                            f"({_first_line(exc)}); check AWS_ACCESS_KEY_ID / AWS_SECRET_ACCESS_KEY "
                                            "and the bucket's permissions") from exc
                 last: BaseException = exc
             except OSError as exc:
                 if name in _DOWNLOADS and exc.errno in _DISK_ERRNOS:
-                    raise InputError(_local_dir(name, args, kwargs),
-                                     f"cannot hold the download of {_remote_name(name, args)} ({exc.strerror}); free "
+                    raise InputError(_local_dir(args, kwargs),
+                                     f"cannot hold the download of {self._name(name, args)} ({exc.strerror}); free "
                                      "space on this disk, or set REACT3D_CACHE to a larger one") from None
                 if not is_store_transient(exc):
                     raise
@@ -167,11 +172,11 @@ class ResilientFS:
         elapsed = time.monotonic() - t0
         if elapsed + wait > budget:
             raise StoreUnavailableError(
-                f"{_remote_name(name, args)}: the store at {self.endpoint} did not answer for {elapsed:.0f} s "
+                f"{self._name(name, args)}: the store at {self.endpoint} did not answer for {elapsed:.0f} s "
                 f"({tries} tries of {name}; last: {_first_line(last)}); is it running? "
                 "(AWS_ENDPOINT_URL; REACT3D_STORE_RETRY_SECONDS sets how long to wait)") from last
         _log.warning("react3d: the store at %s did not answer %s of %s (%s); try %d in %.0f s",
-                     self.endpoint, name, _remote_name(name, args), _first_line(last), tries + 1, wait)
+                     self.endpoint, name, self._name(name, args), _first_line(last), tries + 1, wait)
         time.sleep(wait)
 
 

@@ -13,6 +13,7 @@ import subprocess
 import sys
 import threading
 import time
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -24,7 +25,7 @@ pytestmark = pytest.mark.skipif(s3rver_command() is None, reason="s3rver not ins
 
 
 @pytest.fixture()
-def own_s3(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> S3Server:
+def own_s3(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Iterator[S3Server]:
     """A server of this test's own (tests here kill it), clients pointed at it, a local cache under tmp_path."""
     srv = S3Server(tmp_path / "s3" / "data")
     for k, v in srv.env.items():
