@@ -75,24 +75,33 @@ def s3rver_command() -> list[str] | None:
 
 
 class S3Server:
-    """s3rver on 127.0.0.1 with one bucket; objects are files under ``data``. ``env`` points clients at it."""
+    """s3rver on 127.0.0.1 with one bucket; objects are files under ``data``. ``env`` points clients at it.
+
+    ``kill()`` and ``start()`` stop it the hard way and bring it back on the same port and folder (the
+    store restarting under running workers)."""
 
     def __init__(self, data: Path, bucket: str = "react3d") -> None:
         cmd = s3rver_command()
         if cmd is None:
             raise FileNotFoundError("s3rver is not installed: run `bash scripts/setup.sh test` (needs npm)")
+        self.cmd, self.data = cmd, data
         self.port = free_port()
         self.bucket = bucket
         data.mkdir(parents=True, exist_ok=True)
-        self.log = open(data.parent / f"s3rver-{self.port}.log", "wb")  # noqa: SIM115 - closed in close()
-        self.proc = subprocess.Popen([*cmd, "--directory", str(data), "--address", "127.0.0.1", "--port",
-                                      str(self.port), "--configure-bucket", bucket, "--silent"],
+        self.log = open(data.parent / f"s3rver-{self.port}.log", "ab")  # noqa: SIM115 - closed in close()
+        self.env = {"AWS_ENDPOINT_URL": f"http://127.0.0.1:{self.port}", "AWS_ACCESS_KEY_ID": "S3RVER",
+                    "AWS_SECRET_ACCESS_KEY": "S3RVER", "AWS_DEFAULT_REGION": "us-east-1"}
+        self.proc: subprocess.Popen[bytes] | None = None
+        self.start()
+
+    def start(self) -> None:
+        """Start the server (again) on this port and folder; returns once it accepts connections."""
+        self.proc = subprocess.Popen([*self.cmd, "--directory", str(self.data), "--address", "127.0.0.1", "--port",
+                                      str(self.port), "--configure-bucket", self.bucket, "--silent"],
                                      stdout=self.log, stderr=subprocess.STDOUT, start_new_session=True,
                                      # s3rver 3.7 encrypts listing continuation tokens (> 1000 keys) with a
                                      # cipher OpenSSL 3 (Node >= 17) keeps in its legacy provider
                                      env={**os.environ, "NODE_OPTIONS": "--openssl-legacy-provider"})
-        self.env = {"AWS_ENDPOINT_URL": f"http://127.0.0.1:{self.port}", "AWS_ACCESS_KEY_ID": "S3RVER",
-                    "AWS_SECRET_ACCESS_KEY": "S3RVER", "AWS_DEFAULT_REGION": "us-east-1"}
         t0 = time.time()
         while True:  # s3rver answers 403 to anonymous requests: wait for the port instead
             if self.proc.poll() is not None:
@@ -105,11 +114,23 @@ class S3Server:
                     raise TimeoutError("s3rver did not start within 30 s") from None
                 time.sleep(0.2)
 
+    def kill(self) -> None:
+        """SIGKILL the server (a crash: requests in flight are cut, connections refused until ``start``)."""
+        if self.proc is not None:
+            kill_tree(self.proc.pid)
+            self.proc = None
+
     def url(self, prefix: str) -> str:
         return f"s3://{self.bucket}/{prefix.strip('/')}"
 
+    def object_file(self, key: str) -> Path:
+        """The file s3rver keeps the bytes of ``key`` in (a test damages it there, behind the server's back)."""
+        return self.data / self.bucket / f"{key.strip('/')}._S3rver_object"
+
     def close(self) -> None:
-        kill_tree(self.proc.pid, signal.SIGTERM)
+        if self.proc is not None:
+            kill_tree(self.proc.pid, signal.SIGTERM)
+            self.proc = None
         self.log.close()
 
     def __enter__(self) -> S3Server:

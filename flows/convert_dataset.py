@@ -6,7 +6,8 @@ one flow run per scene through that deployment (``run_deployment``, non-blocking
 ``scene_concurrency`` in flight, so every worker of the pool takes scenes; a run that *crashed* (its
 worker or machine died, OOM kill; marked Crashed by the worker or by the zombie automation of
 deployments/setup.py) is submitted again, up to ``max_attempts`` runs in all, and resumes from the cached
-tasks in the shared store on whichever worker picks it up; a run that *failed* (bad input, a bug) is
+tasks in the shared store on whichever worker picks it up; so is a run that failed because its object
+store did not answer within its retry budget; a run that *failed* otherwise (bad input, a bug) is
 reported once with its reason; a run that no worker starts within ``start_timeout`` seconds, or that does
 not finish within ``run_timeout``, is cancelled and submitted again like a crashed one. Both modes end with the same table artifact (ok / failed with reason /
 retries) and return its rows (docs/orchestration.md).
@@ -233,11 +234,23 @@ def fan_out(scenes: list[Any], out_root: str, config: dict[str, Any] | None, dep
                 elif state.is_crashed() and attempt < max_attempts:
                     history[name].append(f"attempt {attempt} crashed: {_reason(state.message or state.name or '')}")
                     queue.append((name, attempt + 1))  # its finished tasks are cached: the next run resumes
+                elif state.is_failed() and attempt < max_attempts and store_was_down(state.message):
+                    history[name].append(f"attempt {attempt} failed: {_reason(state.message or '')}")
+                    queue.append((name, attempt + 1))  # the store may be back: resume from the cache
                 else:
                     why = "crashed" if state.is_crashed() else state.type.value.lower()
                     rows[name] = _row(name, "failed", started[name],
                                       error=_with_history(history[name], f"{why}: {_reason(state.message or state.name or '')}"), **common)
     return [rows[s.name] for s in scenes]
+
+
+def store_was_down(message: str | None) -> bool:
+    """Whether a failed run failed because its store did not answer within the retry budget
+    (tasks/remote_fs.py): the one failure that submitting the scene again can fix. Prefect keeps only the
+    message of a failed run (``Flow run encountered an exception: StoreUnavailableError: ...``)."""
+    from tasks.remote_fs import StoreUnavailableError
+
+    return f"{StoreUnavailableError.__name__}:" in (message or "")
 
 
 class _InFlight:

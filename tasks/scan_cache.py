@@ -7,13 +7,15 @@ size, the remote ETag and the sha256 of what was downloaded; its modification ti
 use. A later conversion of the same URL reuses the copy when the remote listing (names, sizes, ETags) is
 unchanged and the local files still have their recorded sizes; anything else downloads it again. Every
 downloaded file is checked against the remote size, and against the ETag when that is a plain MD5 (a
-single-part upload). The content keys do not change: they hash the scan's files (``fingerprint_scene``),
+single-part upload); a file that does not match is read once more if the listing changed meanwhile, and
+otherwise refused with one line naming it (damaged in the store). The content keys do not change: they hash the scan's files (``fingerprint_scene``),
 never its location.
 
 Bounded: ``REACT3D_SCAN_CACHE_GB`` (default 20). Before a download, the least recently used entries are
 evicted until the new scan fits; an entry a conversion is reading (a shared ``flock`` on its record,
 held for the whole conversion) is never evicted. A scan larger than the bound, or one that cannot fit
-beside the scans in use, is refused with one line.
+beside the scans in use, or on a disk without that much free space, is refused with one line before
+its download starts.
 """
 
 from __future__ import annotations
@@ -90,7 +92,15 @@ def local_scene(url: str) -> Iterator[Path]:
         if not _usable(record, dest, listing):
             fcntl.flock(lock, fcntl.LOCK_EX)  # waits for this scan's running conversions: one downloader
             if not _usable(record, dest, listing):
-                _download(url, listing, key, record, dest)
+                try:
+                    _download(url, listing, key, record, dest)
+                except ScanMismatchError:
+                    # an object that changed while it was read is read again, once; one damaged in the
+                    # store lists the same again and is refused with its line
+                    again = _listing(url)
+                    if again == listing:
+                        raise
+                    _download(url, again, key, record, dest)
             fcntl.flock(lock, fcntl.LOCK_SH)
         os.utime(record)  # last use
         yield dest
@@ -119,6 +129,7 @@ def _download(url: str, listing: dict[str, dict[str, Any]], key: str, record: Pa
     record.unlink(missing_ok=True)
     shutil.rmtree(dest.parent, ignore_errors=True)
     evict(need, keep=key)
+    check_free_space(cache_dir(), need, url)
     fs, path = storage.filesystem(url)
     path = path.rstrip("/")
     dest.parent.mkdir(parents=True, exist_ok=True)
@@ -133,14 +144,31 @@ def _download(url: str, listing: dict[str, dict[str, Any]], key: str, record: Pa
         for rel, t in zip(rels, targets):
             size, sha, md5 = _digest(t)
             want = listing[rel]
-            if size != want["size"] or (_md5_etag(want["etag"]) and md5 != want["etag"]):
-                raise InputError(f"{url}/{rel}", f"downloaded {size} bytes that do not match the store's "
-                                                 f"{want['size']} bytes / ETag: a truncated or changing object; run again")
+            if size != want["size"]:
+                raise ScanMismatchError(f"{url}/{rel}", f"downloaded {size} bytes, the store lists {want['size']}: "
+                                                        "a truncated or changing object; run again")
+            if _md5_etag(want["etag"]) and md5 != want["etag"]:
+                raise ScanMismatchError(f"{url}/{rel}", f"the downloaded bytes do not match the store's ETag (MD5 "
+                                                        f"{md5[:12]}..., ETag {want['etag'][:12]}...): the object is "
+                                                        "damaged in the store (truncated?) or changed while read; "
+                                                        "upload it again")
             files[rel] = {**want, "sha256": sha}
         os.replace(tmp, dest)
         record.write_text(json.dumps({"url": url, "files": files, "bytes": need}, indent=0), encoding="utf-8")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+class ScanMismatchError(InputError):
+    """A downloaded scan file that does not match the store's listing (size, or MD5 ETag)."""
+
+
+def check_free_space(where: Path, need: int, url: str) -> None:
+    """Refuse a download the local disk cannot hold, before it starts (one line)."""
+    free = shutil.disk_usage(where).free
+    if need > free:
+        raise InputError(where, f"the scan {url} is {need / 1e9:.2f} GB and this disk has {free / 1e9:.2f} GB "
+                                "free; free space, or set REACT3D_CACHE to a larger disk")
 
 
 def _digest(path: Path) -> tuple[int, str, str]:

@@ -91,16 +91,26 @@ def _fs_cached(protocol_url: str, env_key: str) -> Any:  # noqa: ARG001 - env_ke
     import fsspec
 
     # fsspec keeps one instance per constructor arguments, and the endpoint and keys come from the
-    # environment, not the arguments: without skipping its cache a new endpoint would reuse the old client
-    return fsspec.core.url_to_fs(protocol_url, skip_instance_cache=True)[0]
+    # environment, not the arguments: without skipping its cache a new endpoint would reuse the old client.
+    # Listings are not cached: other workers write the same prefixes, and a stale listing would hide them.
+    opts = {"use_listings_cache": False} if protocol_url.split("://")[0] in ("s3", "s3a") else {}
+    fs = fsspec.core.url_to_fs(protocol_url, skip_instance_cache=True, **opts)[0]
+    if protocol_url == "file://":
+        return fs
+    from .remote_fs import ResilientFS
+
+    return ResilientFS(fs, os.environ.get("AWS_ENDPOINT_URL") or protocol_url)
 
 
 def filesystem(url: str) -> tuple[Any, str]:
-    """The fsspec filesystem for ``url`` and the path inside it (clients cached per endpoint)."""
+    """The fsspec filesystem for ``url`` and the path inside it (clients cached per endpoint and keys).
+
+    A remote one retries an unreachable store and fails with one line (tasks/remote_fs.py)."""
     import fsspec
 
     protocol, path = fsspec.core.split_protocol(url)
-    env_key = "|".join(os.environ.get(k, "") for k in ("AWS_ENDPOINT_URL", "AWS_ACCESS_KEY_ID"))
+    secret = hashlib.sha256(os.environ.get("AWS_SECRET_ACCESS_KEY", "").encode()).hexdigest()[:16]
+    env_key = "|".join([*(os.environ.get(k, "") for k in ("AWS_ENDPOINT_URL", "AWS_ACCESS_KEY_ID")), secret])
     fs = _fs_cached(f"{protocol}://" if protocol else "file://", env_key)
     return fs, fs._strip_protocol(url)
 

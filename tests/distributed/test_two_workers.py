@@ -5,8 +5,9 @@ process pool with two `prefect worker` processes, the convert-scene deployment, 
    (SIGKILL of its process tree, by PID) during a scene: the run is marked Crashed (heartbeat automation),
    resubmitted, and finishes on the other worker with its finished tasks read from the cache.
 2. The same dataset with the scans, the store and the outputs on an S3-compatible server (s3rver,
-   objects on disk) gives the same manifests as the shared-folder run; a bad-input scene fails once,
-   with its reason.
+   objects on disk), the server killed and restarted mid-scene while a reader polls the outputs prefix:
+   the same manifests as the shared-folder run, a bad-input scene fails once with its reason, and the
+   reader never sees half an output.
 3. A scene's process killed under a living worker (the OOM case) is Crashed at once and retried.
 
 Run: python -m pytest -m slow tests/distributed/test_two_workers.py -v
@@ -16,6 +17,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -108,7 +110,80 @@ def _diff_paths(a: Any, b: Any, at: str = "") -> list[str]:
     return [] if a == b else [at or "/"]
 
 
-def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Path, tmp_path: Path) -> None:
+class _OutputPoller(threading.Thread):
+    """A reader polling the outputs prefix during the run: every scene whose pointer it sees is fetched the
+    way ``view``/``export`` fetch it (names and sizes listed, every object's sha256 checked against the
+    pointer). A refusal of a pointer that did not change meanwhile is a half output seen by a reader."""
+
+    def __init__(self, out: str) -> None:
+        super().__init__(daemon=True)
+        self.out, self.stop = out.rstrip("/"), threading.Event()
+        self.polls = self.reads = self.store_down = 0
+        self.first_seen: dict[str, float] = {}
+        self.violations: list[str] = []
+
+    def poll(self) -> None:
+        from tasks import storage
+
+        fs, path = storage.filesystem(self.out)
+        try:
+            names = [d.rstrip("/").rsplit("/", 1)[-1] for d in fs.ls(path, detail=False)]
+        except FileNotFoundError:
+            names = []
+        for name in names:
+            url = f"{self.out}/{name}"
+            if not fs.exists(f"{path}/{name}/{storage.OUTPUT_POINTER}"):
+                continue  # not published yet: readers refuse it (tested in test_output_pointer.py)
+            try:
+                before = storage.read_pointer(url)["sha"]
+                copy = storage.fetch_output(url)
+                json.loads((copy / "scene.json").read_text())
+            except ConnectionError:
+                self.store_down += 1  # the store is down (killed on purpose): nothing was read
+                continue
+            except Exception as exc:  # noqa: BLE001 - judged below
+                try:
+                    changed = storage.read_pointer(url)["sha"] != before
+                except Exception:  # noqa: BLE001
+                    changed = False
+                if not changed:
+                    self.violations.append(f"{url}: {type(exc).__name__}: {exc}")
+                continue
+            self.reads += 1
+            self.first_seen.setdefault(name, time.time())
+        self.polls += 1
+
+    def run(self) -> None:
+        while not self.stop.is_set():
+            try:
+                self.poll()
+            except ConnectionError:
+                self.store_down += 1
+            except Exception as exc:  # noqa: BLE001 - a listing that fails otherwise is reported
+                self.violations.append(f"listing {self.out}: {type(exc).__name__}: {exc}")
+            self.stop.wait(0.5)
+
+
+def _kill_store_mid_scene(cluster: LocalCluster, s3: S3Server, proc: Any, deadline: float, down_s: float) -> dict[str, Any]:
+    """Once a scene runs with a finished task, SIGKILL the store, keep it down ``down_s`` (longer than
+    botocore's own retries), start it again on the same port and folder."""
+    while time.time() < deadline and proc.poll() is None:
+        for r in cluster.scene_runs():
+            if r["state_type"] == "RUNNING" and any(t["state_type"] == "COMPLETED" for t in cluster.task_runs(r["id"])):
+                t0 = time.time()
+                s3.kill()
+                time.sleep(down_s)
+                s3.start()
+                return {"scene": r["name"], "killed_at": t0, "down_s": round(time.time() - t0, 1)}
+        time.sleep(0.5)
+    raise AssertionError("no scene was running with a finished task")
+
+
+def test_s3_dataset_survives_a_store_restart_readers_never_see_half_outputs(
+        dataset: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Scans, store and outputs on the S3 server; the server is killed and restarted mid-scene while a
+    reader polls the outputs prefix. Every scene ends complete (same manifests as the shared-folder run)
+    or reported failed (the bad-input scene, once, with its reason); the reader never sees half an output."""
     if s3rver_command() is None:
         pytest.skip("s3rver not installed (bash scripts/setup.sh test)")
     if "local" not in _RESULTS:
@@ -118,51 +193,67 @@ def test_s3_store_gives_the_same_manifests_and_bad_input_fails_once(dataset: Pat
     bad = dataset.parent / "with-bad"
     bad.mkdir(exist_ok=True)
     for name in SCENES:
-        (bad / name).symlink_to(dataset / name)
-    (bad / "broken" / "scans").mkdir(parents=True)
+        if not (bad / name).exists():
+            (bad / name).symlink_to(dataset / name)
+    (bad / "broken" / "scans").mkdir(parents=True, exist_ok=True)
     (bad / "broken" / "scans" / "mesh_aligned_0.05.ply").write_bytes(b"not a mesh")
     with S3Server(tmp_path / "s3" / "data") as s3:
         store, out, scans = s3.url("store"), s3.url("out"), s3.url("scans")
-        import os
-
-        os.environ.update(s3.env)
-        try:  # the scans are read from the bucket: each worker downloads its scenes into its scan cache
-            fs, path = storage.filesystem(scans)
-            fs.pipe({f"{path}/{name}/{q.relative_to(bad / name).as_posix()}": q.read_bytes()
-                     for name in (*SCENES, "broken") for q in (bad / name).rglob("*") if q.is_file()})
-        finally:
-            for k in s3.env:
-                os.environ.pop(k, None)
+        for k, v in s3.env.items():
+            monkeypatch.setenv(k, v)
+        monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "reader-cache"))  # this process: the uploader, the reader
+        monkeypatch.setenv("REACT3D_STORE_RETRY_SECONDS", "5")  # the reader: skip a poll while the store is down
+        monkeypatch.delenv("REACT3D_STORE", raising=False)
+        # the scans are read from the bucket: each worker downloads its scenes into its scan cache
+        fs, path = storage.filesystem(scans)
+        fs.pipe({f"{path}/{name}/{q.relative_to(bad / name).as_posix()}": q.read_bytes()
+                 for name in (*SCENES, "broken") for q in (bad / name).rglob("*") if q.is_file()})
+        poller = _OutputPoller(out)
+        t0 = time.time()
         with LocalCluster(tmp_path / "cluster", n_workers=2, store=store, extra_env=s3.env) as c:
-            r = c.convert_dataset([scans, "--out", out, *ARGS])
+            poller.start()
+            t_run = time.time()
+            proc = c.convert_dataset([scans, "--out", out, *ARGS], wait=False)
+            outage = _kill_store_mid_scene(c, s3, proc, time.time() + 900, down_s=30)
+            rc = proc.wait(timeout=1500)
+            t_end = time.time()
+            poller.stop.set()
+            poller.join(timeout=120)
+            poller.poll()  # once more, after the last publication
             runs = c.scene_runs()
             rows = _rows(c)
-        assert r.returncode == 1, r.stdout + r.stderr  # one scene failed
+            worker_logs = "".join((c.home / f"worker-{i}.log").read_text(errors="replace") for i in range(2))
+            log = (c.home / "convert-dataset.log").read_text(errors="replace")
+        summary = {"run_s": round(t_end - t_run, 1), "with_cluster_s": round(time.time() - t0, 1), "outage": outage,
+                   "polls": poller.polls, "verified_reads": poller.reads, "polls_store_down": poller.store_down,
+                   "store_retries_logged": worker_logs.count("did not answer"),
+                   "record_writes_failed": worker_logs.count("committing transaction"),
+                   "rows": {k: {f: v[f] for f in ("status", "seconds", "retries", "worker", "error")} for k, v in rows.items()}}
+        print("\nS3 run:", json.dumps(summary, indent=1))
+        (tmp_path.parent / "s3-run-summary.json").write_text(json.dumps(summary, indent=1))
+        assert not poller.violations, poller.violations  # no reader ever saw half an output
+        assert rc == 1, log[-3000:]  # one scene failed
+        assert sorted(rows) == sorted([*SCENES, "broken"]) and all(r["status"] in ("ok", "failed") for r in rows.values())
+        assert all(r["error"] for r in rows.values() if r["status"] == "failed"), rows
         assert rows["broken"]["status"] == "failed" and rows["broken"]["retries"] == 0 and rows["broken"]["error"], rows
         assert [x["name"] for x in runs if x["name"].startswith("broken-")] == ["broken-attempt1"]
-        import os
-
-        os.environ.update(s3.env)
-        try:
-            for name in SCENES:
-                assert rows[name]["status"] == "ok", rows
-                local = _RESULTS["local"] / name / "scene.json"
-                remote = storage.output_manifest(f"{out}/{name}")  # through its pointer
-                a, b = _normalized_manifest(remote, storage.read_text(remote)), _normalized_manifest(local, local.read_text())
-                assert a == b, f"{name}: manifests differ at {_diff_paths(a, b)[:10]}"
-                assert sorted(storage.read_pointer(f"{out}/{name}")["files"]) == sorted(  # names, sizes checked
-                    p.relative_to(local.parent).as_posix() for p in local.parent.rglob("*") if p.is_file())
-                fs, path = storage.filesystem(remote.rsplit("/", 1)[0])
-                remote_files = {p[len(path) + 1:]: hashlib.sha256(fs.cat_file(p)).hexdigest() for p in fs.find(path)}
-                local_files = {p.relative_to(local.parent).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
-                               for p in local.parent.rglob("*") if p.is_file()}
-                same = {k for k in local_files if remote_files.get(k) == local_files[k]}
-                # meshes, URDF, metrics: byte-identical; the manifest, report, marker and physics record carry times
-                assert set(local_files) - same <= {"scene.json", "report.html", ".react3d-output", "physics_check.json"}, name
-                assert set(remote_files) == set(local_files), name
-        finally:
-            for k in s3.env:
-                os.environ.pop(k, None)
+        for name in SCENES:
+            assert rows[name]["status"] == "ok", rows
+            assert name in poller.first_seen, (name, poller.first_seen)  # the reader saw each output whole
+            local = _RESULTS["local"] / name / "scene.json"
+            remote = storage.output_manifest(f"{out}/{name}")  # through its pointer
+            a, b = _normalized_manifest(remote, storage.read_text(remote)), _normalized_manifest(local, local.read_text())
+            assert a == b, f"{name}: manifests differ at {_diff_paths(a, b)[:10]}"
+            assert sorted(storage.read_pointer(f"{out}/{name}")["files"]) == sorted(  # names, sizes checked
+                p.relative_to(local.parent).as_posix() for p in local.parent.rglob("*") if p.is_file())
+            fs, path = storage.filesystem(remote.rsplit("/", 1)[0])
+            remote_files = {p[len(path) + 1:]: hashlib.sha256(fs.cat_file(p)).hexdigest() for p in fs.find(path)}
+            local_files = {p.relative_to(local.parent).as_posix(): hashlib.sha256(p.read_bytes()).hexdigest()
+                           for p in local.parent.rglob("*") if p.is_file()}
+            same = {k for k in local_files if remote_files.get(k) == local_files[k]}
+            # meshes, URDF, metrics: byte-identical; the manifest, report, marker and physics record carry times
+            assert set(local_files) - same <= {"scene.json", "report.html", ".react3d-output", "physics_check.json"}, name
+            assert set(remote_files) == set(local_files), name
 
 
 def test_flow_run_killed_under_a_living_worker_is_retried(dataset: Path, tmp_path: Path) -> None:
@@ -197,3 +288,43 @@ def test_flow_run_killed_under_a_living_worker_is_retried(dataset: Path, tmp_pat
     assert runs["s0-attempt1"]["state_type"] == "CRASHED" and "SIGKILL" in runs["s0-attempt1"]["state"]["message"]
     assert runs["s0-attempt2"]["state_type"] == "COMPLETED" and rows["s0"]["retries"] == 1
     assert "Cached" in perceive, perceive  # the batches finished before the kill are not recomputed
+
+
+def test_a_scene_failed_by_a_store_down_past_its_budget_is_submitted_again(dataset: Path, tmp_path: Path) -> None:
+    """The store (S3 server) dies while a scene runs and stays down longer than the worker's retry budget
+    (4 s here): the run fails with the store's one line, the scene is submitted again, and once the store
+    is back the next attempt converts it; the table keeps the first attempt's reason."""
+    if s3rver_command() is None:
+        pytest.skip("s3rver not installed (bash scripts/setup.sh test)")
+    import shutil
+
+    one = tmp_path / "one"
+    one.mkdir()
+    shutil.copytree(dataset / "s0", one / "s0")
+    with S3Server(tmp_path / "s3" / "data") as s3:
+        with LocalCluster(tmp_path / "cluster", n_workers=1, store=s3.url("store"),
+                          extra_env={**s3.env, "REACT3D_STORE_RETRY_SECONDS": "4"}) as c:
+            proc = c.convert_dataset([str(one), "--out", s3.url("out"), *ARGS], wait=False)
+            deadline = time.time() + 600
+            state = ""
+            while state != "RUNNING" and proc.poll() is None and time.time() < deadline:
+                state = {r["name"]: r["state_type"] for r in c.scene_runs()}.get("s0-attempt1", "")
+                time.sleep(0.5)
+            s3.kill()
+            t_down = time.time()
+            while state not in ("FAILED", "COMPLETED", "CRASHED") and proc.poll() is None and time.time() < deadline:
+                state = {r["name"]: r["state_type"] for r in c.scene_runs()}.get("s0-attempt1", "")
+                time.sleep(0.5)
+            s3.start()
+            down_s = time.time() - t_down
+            rc = proc.wait(timeout=900)
+            runs = {r["name"]: r for r in c.scene_runs()}
+            rows = _rows(c)
+            log = (c.home / "convert-dataset.log").read_text(errors="replace")
+    print(f"\nstore down {down_s:.1f} s; rows: {json.dumps(rows, indent=1)}")
+    assert rc == 0, log[-3000:]
+    first = runs["s0-attempt1"]
+    assert first["state_type"] == "FAILED" and "StoreUnavailableError" in first["state"]["message"], first["state"]
+    assert runs["s0-attempt2"]["state_type"] == "COMPLETED"
+    assert rows["s0"]["status"] == "ok" and rows["s0"]["retries"] == 1, rows
+    assert rows["s0"]["error"].startswith("attempt 1 failed: ") and "did not answer" in rows["s0"]["error"], rows
