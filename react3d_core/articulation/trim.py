@@ -3,13 +3,14 @@
 Validation (the paper) needs one top view whose predicted part mask matches the candidate's. A
 re-segmentation that grew a drawer into the door below it (SAM answering a click with the whole
 cabinet) passes in a view where the door is hidden, and the drawer's joint is then given to the
-drawer and the door together: neither matches its GT part (on the large kitchens, most of what is lost
-is such merges). The views tell them apart: the faces the validating view shows inside its predicted
-mask are the part's *core*; in every other top view the prediction that covers the core's pixels is the
+drawer and the door together: the part matches neither (a false part, with a joint fitted to the
+wrong box). The views tell them apart: the faces the validating view shows inside its predicted mask
+are the part's *core*; in every other top view the prediction that covers the core's pixels is the
 same part seen again, and the candidate's faces that view shows outside that mask belong to something
 else. A face goes when more views show it outside than inside; a face no view shows (the back of a
 front, kept by the segmentation's slab) follows the nearest face a view does show. A trim that would
-remove less than ``min_share`` of the faces is not made (mask edges, handles).
+remove less than ``min_share`` of the faces is not made (mask edges, handles). Two parts that no one
+view shows together (each top view sees one of them) cannot be told apart this way and stay merged.
 
 Views are rendered at ``width`` px (face ids per pixel); masks are compared there, dilated by ``grow_px``.
 """
