@@ -1,16 +1,18 @@
 """Trim a candidate that holds a neighbour to the part the articulation predictor sees.
 
 Validation (the paper) needs one top view whose predicted part mask matches the candidate's. A
-re-segmentation that grew a drawer into the door below it (SAM answering a click with the whole
-cabinet) passes in a view where the door is hidden, and the drawer's joint is then given to the
-drawer and the door together: the part matches neither (a false part, with a joint fitted to the
-wrong box). The views tell them apart: the faces the validating view shows inside its predicted mask
-are the part's *core*; in every other top view the prediction that covers the core's pixels is the
-same part seen again, and the candidate's faces that view shows outside that mask belong to something
-else. A face goes when more views show it outside than inside; a face no view shows (the back of a
-front, kept by the segmentation's slab) follows the nearest face a view does show. A trim that would
-remove less than ``min_share`` of the faces is not made (mask edges, handles). Two parts that no one
-view shows together (each top view sees one of them) cannot be told apart this way and stay merged.
+re-segmentation that grew a drawer into the door below it (SAM answering a click with the whole cabinet)
+passes in a view where the door is hidden, and the drawer's joint is then given to the drawer and the
+door together: the part matches neither (a false part, with a joint fitted to the wrong box). The views
+tell them apart: the faces the validating view shows inside its predicted mask are the part's *core*; in
+every other top view the prediction that covers the core's pixels is the same part seen again, and the
+candidate's faces that view shows outside that mask belong to something else. Views are taken in turn,
+the one showing most of the part known so far first, and what each shows inside its covering prediction
+joins the part, so a view that sees none of the core but other faces of the part still speaks. A face
+goes when more views show it outside than inside; a face no view shows (the back of a front, kept by the
+segmentation's slab) follows the nearest face a view does show. A trim that would remove less than
+``min_share`` of the faces is not made (mask edges, handles). Two parts that no one view shows together
+(each top view sees one of them) cannot be told apart this way and stay merged.
 
 Views are rendered at ``width`` px (face ids per pixel); masks are compared there, dilated by ``grow_px``.
 """
@@ -68,28 +70,24 @@ def trim_to_prediction(candidate: PartCandidate, best: ArticulationPrediction, b
     fb = buffers[best_view]
     m_best = _grow(_resize(best.mask, fb.shape), grow_px)
     seen, inside = _face_votes(fb, faces, m_best)
-    core = faces[inside]
-    if len(core) == 0:
+    core = inside.copy()
+    if not core.any():
         return candidate
     votes_in, votes_out = inside.astype(int), (seen & ~inside).astype(int)
-    for fid in views:
-        if fid == best_view:
+    todo = [fid for fid in views if fid != best_view]
+    while todo:  # the view showing most of the part known so far next; what it shows inside joins the part
+        px = {fid: np.isin(buffers[fid], faces[core]) for fid in todo}
+        fid = max(todo, key=lambda k: int(px[k].sum()))
+        todo.remove(fid)
+        if px[fid].sum() < 20:
+            break  # no view left shows the part: none can say what else the candidate holds
+        mask = _covering_prediction(predictions.get(fid, []), px[fid], grow_px)
+        if mask is None:
             continue
-        fb = buffers[fid]
-        core_px = np.isin(fb, core)
-        if core_px.sum() < 20:
-            continue  # the core is hardly visible here: this view cannot say what the part is
-        best_cover, mask = 0.0, None
-        for p in predictions.get(fid, []):
-            m = _grow(_resize(p.mask, fb.shape), grow_px)
-            cover = float((m & core_px).sum() / core_px.sum())
-            if cover > best_cover:
-                best_cover, mask = cover, m
-        if mask is None or best_cover < 0.5:
-            continue
-        seen, inside = _face_votes(fb, faces, mask)
+        seen, inside = _face_votes(buffers[fid], faces, mask)
         votes_in += inside
         votes_out += seen & ~inside
+        core |= inside
     drop = votes_out > votes_in
     if drop.sum() < min_share * len(faces):
         return candidate
@@ -98,6 +96,17 @@ def trim_to_prediction(candidate: PartCandidate, best: ArticulationPrediction, b
         return candidate
     keep = faces[~drop]
     return _with_faces(candidate, keep, np.asarray(mesh.faces)[keep], buffers)
+
+
+def _covering_prediction(preds: list[ArticulationPrediction], part_px: np.ndarray, grow_px: int) -> np.ndarray | None:
+    """The (grown) mask of the prediction covering most of ``part_px``, when it covers at least half of it."""
+    best_cover, mask = 0.0, None
+    for p in preds:
+        m = _grow(_resize(p.mask, part_px.shape), grow_px)
+        cover = float((m & part_px).sum() / part_px.sum())
+        if cover > best_cover:
+            best_cover, mask = cover, m
+    return mask if best_cover >= 0.5 else None
 
 
 def _unseen_follow_nearest(centroids: np.ndarray, voted: np.ndarray, drop: np.ndarray) -> np.ndarray:

@@ -121,3 +121,35 @@ def test_articulation_stage_trims_only_when_configured() -> None:
     np.testing.assert_array_equal(np.sort(off.face_ids), np.sort(both))
     assert abs(max(on.obb.extents) - 0.6) < 0.01 and abs(sorted(on.obb.extents)[1] - 0.18) < 0.01
     assert abs(sorted(off.obb.extents)[1] - 0.6) < 0.01 and abs(max(off.obb.extents) - 0.8) < 0.01
+
+
+def test_a_view_that_sees_none_of_the_core_speaks_through_the_part_seen_in_between() -> None:
+    """near sees the drawer's left part (the core) only; mid sees the drawer's middle, no door; far sees the
+    drawer's right part and the door, the core hidden behind a post. far's drawer prediction covers none
+    of the core, but it covers what mid added to the part, so far's door faces go."""
+    drawer, door = grid(0.0, 0.6, 0.62, 0.8, -0.05, 12, 4), grid(0.0, 0.6, 0.0, 0.6, -0.05, 12, 12)
+    post = grid(-0.1, 0.3, 0.55, 0.9, -0.3, 4, 4)  # 0.25 m in front of the fronts, between far and the core
+    wall = grid(-1.0, 2.0, -0.5, 1.5, 0.0, 30, 20)
+    mesh, (dr, do, _p, _w) = merge(drawer, door, post, wall)
+
+    def frame(name: str, w: int, h: int, eye: tuple[float, float, float], target: tuple[float, float, float]) -> Frame:
+        intr = Intrinsics(fx=200.0, fy=200.0, cx=w / 2, cy=h / 2, width=w, height=h)
+        return Frame(frame_id=name, rgb=ImageRef(path=Path(f"/nonexistent/{name}.jpg"), kind="jpg"), intrinsics=intr,
+                     pose=look_at(np.array(eye), np.array(target)))
+
+    frames = {"near": frame("near", 320, 240, (0.15, -0.17, 0.71), (0.15, -0.05, 0.71)),
+              "mid": frame("mid", 320, 80, (0.3, -0.25, 0.71), (0.3, -0.05, 0.71)),
+              "far": frame("far", 320, 240, (0.3, -2.0, 0.4), (0.3, 0.0, 0.4))}
+    ras = Rasterizer(mesh)
+    fb = {k: ras.render_frame(f).face_ids for k, f in frames.items()}
+    core = np.unique(fb["near"][np.isin(fb["near"], dr)])
+    assert not np.isin(fb["near"], do).any() and not np.isin(fb["mid"], do).any() and np.isin(fb["far"], do).any()
+    assert not np.isin(fb["far"], core).any() and np.isin(fb["far"], fb["mid"][np.isin(fb["mid"], dr)]).any()
+    preds = {k: [_prediction(k, np.isin(b, dr))] + ([_prediction(k, np.isin(b, do))] if np.isin(b, do).any() else [])
+             for k, b in fb.items()}
+    both = np.concatenate([dr, do])
+    cand = PartCandidate(candidate_id=0, face_ids=both, vertex_ids=np.unique(mesh.faces[both]),
+                         top_views=[TopView(frame_id=k, iou=0.9) for k in ("near", "mid", "far")])
+    out = trim_to_prediction(cand, preds["near"][0], "near", preds, frames, ras, mesh)
+    assert np.isin(dr, out.face_ids).all()
+    assert np.isin(do, out.face_ids).mean() < 0.1  # the door's faces behind the post follow their nearest seen face
