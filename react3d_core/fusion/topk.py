@@ -69,11 +69,12 @@ def top_views_from_stats(
 
     IoUs of all masks with all proposals come from two sparse products of face histograms:
     intersection = mask histogram . proposal membership, silhouette = frame histogram . membership.
-    Masks touching the border are skipped; only for a proposal no other mask matches are they used, so
-    such parts are not lost. An inner mask whose view sees less than ``min_view_cover`` of what the
-    best-seeing matching view sees of the proposal (its surface, ``face_area``; face counts without)
-    is no better than a border mask: the occlusion-aware IoU is high in a view that sees a corner of a
-    tall door past an obstacle, and re-segmenting there returns that corner only.
+    Masks touching the border are skipped; only for a proposal no other mask matches (a part the capture
+    always cuts off, e.g. low cabinets) are they used, so such parts are not lost. An inner mask whose
+    view sees less than ``min_view_cover`` of what the best-seeing matching view sees of the proposal
+    (its surface, ``face_area``; face counts without) is no better than a border mask: the
+    occlusion-aware IoU is high in a view that sees a corner of a tall door past an obstacle, and
+    re-segmenting there returns that corner only.
     """
     n_p = len(proposal_faces)
     out: list[list[TopView]] = [[] for _ in range(n_p)]
