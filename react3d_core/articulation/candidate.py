@@ -1,4 +1,5 @@
-"""Articulation stage: validate a candidate against the predictor, lift its joint, refine it on the OBB.
+"""Articulation stage: validate a candidate against the predictor (trimming a merge back to the predicted
+part), lift its joint, refine it on the OBB.
 
 ``articulate_candidate`` is the per-part entry point (a Prefect task per candidate); motion limits are
 set later in assembly (``limits.set_limits``), once cavities and neighbours are known.
@@ -18,6 +19,7 @@ from ..data.parts import OBB, Articulation, PartCandidate
 from .obb import min_obb
 from .refine import is_flat, refine_prismatic, refine_revolute, refine_sliding, slab_mid_and_thickness
 from .sliding import sliding_agrees
+from .trim import trim_to_prediction
 from .types import ArticulatedPart
 from .upright import upright_box
 from .validate import best_prediction, consensus_joint, lift_prediction, matching_predictions, view_matches
@@ -87,6 +89,14 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
     if pred is None or iou < config.articulation.valid_iou:
         return None
     frames = {f.frame_id: f for f in scene.frames}
+    if config.articulation.trim_to_prediction and rasterizer is not None:
+        trimmed = trim_to_prediction(candidate, pred, view, predictions, frames, rasterizer, mesh)
+        if trimmed is not candidate:  # a merge cut back to the predicted part: validate what is left
+            candidate = trimmed
+            matches = view_matches(candidate, predictions)
+            pred, iou, view = best_prediction(candidate, predictions, matches)
+            if pred is None or iou < config.articulation.valid_iou:
+                return None
     frame = frames[view]
 
     def lifted(p: ArticulationPrediction, fid: str) -> Articulation:

@@ -17,6 +17,10 @@ class ArticulationConfig(StageConfig):
     upright_tolerance: float = Field(0.1, ge=0, description="A vertical front keeps a gravity-aligned box unless the "
                                                             "minimal box is smaller by more than this share of its "
                                                             "volume (0: always the minimal box, as the paper).")
+    trim_to_prediction: bool = Field(True, description="Cut a validated candidate back to the part the predictor sees: faces "
+                                                       "its top views show outside the predicted mask that covers the part "
+                                                       "(more views outside than inside) go, when they are at least a tenth "
+                                                       "of it (a drawer grown into the door below; beyond the paper).")
     sliding_min_height_m: float = Field(0.3, ge=0, description="A 'sliding' prediction is kept only with its axis in the "
                                                               "front plane and on a front at least this tall (a lower "
                                                               "vertical front sliding sideways is a drawer front, which "

@@ -33,6 +33,9 @@ class TopKConfig(StageConfig):
     good_iou: float = Field(0.8, ge=0, le=1, description="IoU of a 'good' view.")
     border_px: int = Field(20, ge=0, description="Skip masks touching the image border within this many px.")
     min_mask_px: int = Field(100, ge=0, description="Skip masks smaller than this.")
+    min_view_cover: float = Field(0.5, ge=0, le=1, description="An inner mask is preferred to border masks only where its view "
+                                                              "sees at least this share of the proposal's surface that the "
+                                                              "best-seeing matching view sees (0: always, as before).")
 
 
 class ClipConfig(StageConfig):

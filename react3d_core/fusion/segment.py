@@ -124,7 +124,7 @@ def candidates_from_proposals(
     each proposal's outcome)."""
     from .reseg import resegment
 
-    tops = top_views_from_stats([p.face_ids for p in proposals], stats, masks, mesh.n_faces, config)
+    tops = top_views_from_stats([p.face_ids for p in proposals], stats, masks, mesh.n_faces, config, mesh.face_areas)
     by_id = {f.frame_id: f for f in scene.frames}
     out = []
     centroids = mesh.face_centroids

@@ -63,13 +63,18 @@ def top_views_from_stats(
     masks: Mapping[str, Sequence[Mask2D]],
     n_faces: int,
     config: PipelineConfig,
+    face_area: np.ndarray | None = None,
 ) -> list[list[TopView]]:
     """For each proposal, its k best views (one mask per frame) with IoU > ``min_iou``, best first.
 
     IoUs of all masks with all proposals come from two sparse products of face histograms:
     intersection = mask histogram . proposal membership, silhouette = frame histogram . membership.
-    Masks touching the border are skipped; only for a proposal no other mask matches (a part the
-    capture always cuts off, e.g. low cabinets) are they used, so such parts are not lost.
+    Masks touching the border are skipped; only for a proposal no other mask matches (a part the capture
+    always cuts off, e.g. low cabinets) are they used, so such parts are not lost. An inner mask whose
+    view sees less than ``min_view_cover`` of what the best-seeing matching view sees of the proposal
+    (its surface, ``face_area``; face counts without) is no better than a border mask: the
+    occlusion-aware IoU is high in a view that sees a corner of a tall door past an obstacle, and
+    re-segmenting there returns that corner only.
     """
     n_p = len(proposal_faces)
     out: list[list[TopView]] = [[] for _ in range(n_p)]
@@ -93,10 +98,17 @@ def top_views_from_stats(
     union = area[:, None] + sil[frame_of] - inter
     with np.errstate(divide="ignore", invalid="ignore"):
         iou = np.where(union > 0, inter / union, 0.0)
+    match = iou > config.topk.min_iou
+    inner = np.repeat(~border[:, None], n_p, 1)
+    if config.topk.min_view_cover > 0:
+        w = np.ones(n_faces) if face_area is None else np.asarray(face_area, float)[:n_faces]
+        seen = (_seen_area(Hf, w) @ P).toarray()[frame_of]  # masks x props: proposal surface the mask's view sees
+        best_seen = np.where(match, seen, 0.0).max(0)
+        inner &= seen >= config.topk.min_view_cover * best_seen
     for p in range(n_p):
         col = iou[:, p]
-        for sel in (~border, border):  # inner masks first; border masks only as a fallback
-            cand = np.nonzero(sel & (col > config.topk.min_iou))[0]
+        for sel in (inner[:, p], np.ones(len(col), bool)):  # inner masks first; all matching masks as a fallback
+            cand = np.nonzero(sel & match[:, p])[0]
             if not len(cand):
                 continue
             best: dict[int, int] = {}
@@ -108,6 +120,13 @@ def top_views_from_stats(
                 mk = masks[st.frame_id][st.mask_index[rows[r][1]]]
                 out[p].append(TopView(frame_id=st.frame_id, iou=float(col[r]), mask=mk))
             break
+    return out
+
+
+def _seen_area(H: sparse.csr_matrix, face_area: np.ndarray) -> sparse.csr_matrix:
+    """Frame x face histogram -> the area of each face the frame sees (pixel counts replaced by area)."""
+    out = H.tocsr(copy=True)
+    out.data = face_area[out.indices]
     return out
 
 

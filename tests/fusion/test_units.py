@@ -197,6 +197,30 @@ def test_top_views_rank_and_skip_border_masks():
     assert select_top_views([a], buffers, only, mesh.n_faces, c.with_overrides({"topk": {"min_iou": 0.0}}))[0][0].frame_id == fid
 
 
+def test_an_inner_view_of_a_corner_does_not_outrank_border_views_of_the_whole():
+    """Proposal = faces 0..9 (unit area each). frame_a sees faces 0 and 1 in the middle of the image
+    (mask IoU 128/144 = 0.89, not at the border); frame_b sees all ten, its mask touching the left border
+    (IoU 1). frame_a sees 2 of the 10 faces frame_b sees: under min_view_cover 0.5 it is no better than a
+    border view, so frame_b (higher IoU) leads; at 0 the inner corner view is the only one kept."""
+    h, w = 64, 96
+    a = np.full((h, w), 50, np.int32)
+    a[28:36, 40:48], a[28:36, 48:56] = 0, 1
+    mask_a = np.zeros((h, w), bool)
+    mask_a[27:36, 40:56] = True
+    b = np.full((h, w), 50, np.int32)
+    for i in range(10):
+        b[20:44, 4 * i : 4 * i + 4] = i
+    buffers = {"frame_a": a, "frame_b": b}
+    masks = {"frame_a": [Mask2D(frame_id="frame_a", mask=mask_a)], "frame_b": [Mask2D(frame_id="frame_b", mask=b < 10)]}
+    c = cfg().with_overrides({"perception": {"hole_close_px": 0}, "topk": {"border_px": 20, "min_mask_px": 100}})
+    prop = [np.arange(10)]
+    tv = select_top_views(prop, buffers, masks, 100, c)[0]
+    assert [t.frame_id for t in tv] == ["frame_b", "frame_a"]
+    assert tv[0].iou == pytest.approx(1.0) and tv[1].iou == pytest.approx(128 / 144)
+    tv = select_top_views(prop, buffers, masks, 100, c.with_overrides({"topk": {"min_view_cover": 0.0}}))[0]
+    assert [t.frame_id for t in tv] == ["frame_a"]
+
+
 # -- re-segmentation prompts -------------------------------------------------------------------
 def test_point_prompts_inside_and_outside():
     sil = np.zeros((60, 80), bool)
