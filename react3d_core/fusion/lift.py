@@ -1,4 +1,8 @@
-"""Per-frame lifting: which visible mesh faces lie under each (hole-filled, eroded) 2D mask."""
+"""Per-frame lifting: which visible mesh faces lie under each (hole-filled, eroded) 2D mask.
+
+A mask's pixels that see through the front (a glass pane the scan lacks, or a hole filled over the
+cabinet's inside) are not lifted: the part is what lies on the plane of the mask's outline.
+"""
 
 from __future__ import annotations
 
@@ -59,14 +63,76 @@ class FrameLift:
     mask_index: list[int] = field(default_factory=list)
 
 
-def filled(mask: np.ndarray, shape: tuple[int, int], config: PipelineConfig) -> np.ndarray:
-    """Mask resized to ``shape`` (nearest) with its holes filled (missed handles)."""
-    return fill_holes(resize_mask(mask, shape), config.perception.hole_close_px)
+def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: float, min_band: int = 12) -> np.ndarray:
+    """Pixels of ``mask`` whose surface (``depth``, metres, 0 = none) lies more than ``behind_m`` behind
+    the plane of the mask's outline: the ``band_px`` wide band inside the mask's edge.
+
+    Why: a frame around a glass pane is one part, but the scan mostly lacks the pane, so inside the
+    frame the views show the shelves and back wall behind it; a hole filled over a missed handle can
+    likewise reach what lies behind. The outline of a front lies on the front (frame, edges), so its
+    plane tells what is seen through. A plane is affine in inverse depth over pixel coordinates
+    (1/z = a u + b v + c for any pinhole camera), fitted by least squares and trimmed twice; no
+    intrinsics needed. Pixels in front of the plane (handles) are never through. Masks with fewer than
+    ``min_band`` band pixels with depth, or a fit that is not in front of the camera, give no pixels.
+    """
+    m = np.asarray(mask, bool)
+    out = np.zeros(m.shape, bool)
+    ys = np.flatnonzero(m.any(1))
+    if not len(ys) or band_px <= 0:
+        return out
+    xs = np.flatnonzero(m.any(0))
+    y0, y1, x0, x1 = ys[0], ys[-1] + 1, xs[0], xs[-1] + 1
+    mc = m[y0:y1, x0:x1]
+    z = np.asarray(depth, np.float32)[y0:y1, x0:x1]
+    has = mc & (z > 0)
+    band = has & ~erode(np.pad(mc, 1), band_px)[1:-1, 1:-1]  # the crop's edge is not the mask's edge
+    inner = has & ~band
+    if band.sum() < min_band or not inner.any():
+        return out
+    by, bx = np.nonzero(band)
+    A = np.stack([bx, by, np.ones_like(bx)], 1).astype(np.float64)
+    zb = z[by, bx].astype(np.float64)
+    keep = np.ones(len(zb), bool)
+    coef = None
+    for tol in (np.inf, 2.0 * behind_m, behind_m):
+        if keep.sum() < min_band:
+            break
+        coef = np.linalg.lstsq(A[keep], 1.0 / zb[keep], rcond=None)[0]
+        wfit = A @ coef
+        zfit = np.divide(1.0, wfit, out=np.full_like(wfit, np.inf), where=wfit > 0)
+        keep = np.abs(zb - zfit) < tol
+    if coef is None:
+        return out
+    iy, ix = np.nonzero(inner)
+    w = coef[0] * ix + coef[1] * iy + coef[2]
+    if not (w > 0).all():
+        return out
+    zi = z[iy, ix].astype(np.float64)
+    thr = np.nonzero(zi > 1.0 / w + behind_m)[0]
+    out[y0 + iy[thr], x0 + ix[thr]] = True
+    return out
 
 
-def prepare_mask(mask: np.ndarray, shape: tuple[int, int], config: PipelineConfig) -> np.ndarray:
-    """Mask at the raster's size, holes filled (handles), eroded (boundary bleed)."""
-    return erode(filled(mask, shape, config), scaled_px(config.fusion.erode_px, shape[1]))
+def filled(mask: np.ndarray, shape: tuple[int, int], config: PipelineConfig, depth: np.ndarray | None = None) -> np.ndarray:
+    """Mask resized to ``shape`` (nearest) with its holes filled (missed handles); with the raster's
+    ``depth`` (at ``shape``), without the pixels that see through the front (:func:`through_pixels`)."""
+    m = fill_holes(resize_mask(mask, shape), config.perception.hole_close_px)
+    return m if depth is None else not_through(m, depth, config, shape[1])
+
+
+def not_through(mask: np.ndarray, depth: np.ndarray, config: PipelineConfig, width: int) -> np.ndarray:
+    """``mask`` without its pixels that see through the front; ``width``: the image's width (``mask``
+    and ``depth`` may be a crop of it), which scales ``fusion.through_band_px``."""
+    band = scaled_px(config.fusion.through_band_px, width)
+    if config.fusion.through_band_px <= 0:
+        return mask
+    return mask & ~through_pixels(mask, depth, max(1, band), config.clip.keep_behind_m)
+
+
+def prepare_mask(mask: np.ndarray, shape: tuple[int, int], config: PipelineConfig, depth: np.ndarray | None = None) -> np.ndarray:
+    """Mask at the raster's size, holes filled (handles), without what is seen through the front
+    (``depth`` given), eroded (boundary bleed)."""
+    return erode(filled(mask, shape, config, depth), scaled_px(config.fusion.erode_px, shape[1]))
 
 
 def lift_masks(raster: RasterResult, masks: Sequence[Mask2D], config: PipelineConfig) -> FrameLift:
@@ -74,7 +140,7 @@ def lift_masks(raster: RasterResult, masks: Sequence[Mask2D], config: PipelineCo
     ids = raster.face_ids
     out = FrameLift(raster.frame_id)
     for i, mk in enumerate(masks):
-        m = prepare_mask(mk.mask, ids.shape, config)
+        m = prepare_mask(mk.mask, ids.shape, config, raster.depth)
         f = ids[m]
         f = np.unique(f[f >= 0])
         if len(f):
@@ -118,7 +184,7 @@ def lift_with_stats(raster: RasterResult, masks: Sequence[Mask2D], config: Pipel
         full = mk.mask
         if not full.any():
             continue
-        filled_m = filled(full, shape, config)
+        filled_m = filled(full, shape, config, raster.depth)
         f = ids[erode(filled_m, e)]
         f = np.unique(f[f >= 0])
         if len(f):
