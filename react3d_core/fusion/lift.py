@@ -63,9 +63,12 @@ class FrameLift:
     mask_index: list[int] = field(default_factory=list)
 
 
-def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: float, min_band: int = 12) -> np.ndarray:
+def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: float, min_band: int = 12,
+                   image_sides: tuple[bool, bool, bool, bool] = (True, True, True, True)) -> np.ndarray:
     """Pixels of ``mask`` whose surface (``depth``, metres, 0 = none) lies more than ``behind_m`` behind
-    the plane of the mask's outline: the ``band_px`` wide band inside the mask's edge.
+    the plane of the mask's outline: the ``band_px`` wide band inside the mask's edge. Where the mask
+    runs into the image's border it is cut off, not outlined: ``image_sides`` (top, bottom, left,
+    right) say which sides of the arrays are the image's border (all of them for a whole image).
 
     Why: a frame around a glass pane is one part, but the scan mostly lacks the pane, so inside the
     frame the views show the shelves and back wall behind it; a hole filled over a missed handle can
@@ -85,7 +88,12 @@ def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: 
     mc = m[y0:y1, x0:x1]
     z = np.asarray(depth, np.float32)[y0:y1, x0:x1]
     has = mc & (z > 0)
-    band = has & ~erode(np.pad(mc, 1), band_px)[1:-1, 1:-1]  # the crop's edge is not the mask's edge
+    top, bottom, left, right = image_sides
+    cut = (top and y0 == 0, bottom and y1 == m.shape[0], left and x0 == 0, right and x1 == m.shape[1])
+    padded = np.pad(mc, 1)  # past the crop's edge the mask ends, unless that edge is the image's border
+    padded[0, :], padded[-1, :] = (padded[1, :] if cut[0] else False), (padded[-2, :] if cut[1] else False)
+    padded[:, 0], padded[:, -1] = (padded[:, 1] if cut[2] else False), (padded[:, -2] if cut[3] else False)
+    band = has & ~erode(padded, band_px)[1:-1, 1:-1]
     inner = has & ~band
     if band.sum() < min_band or not inner.any():
         return out
@@ -120,13 +128,15 @@ def filled(mask: np.ndarray, shape: tuple[int, int], config: PipelineConfig, dep
     return m if depth is None else not_through(m, depth, config, shape[1])
 
 
-def not_through(mask: np.ndarray, depth: np.ndarray, config: PipelineConfig, width: int) -> np.ndarray:
+def not_through(mask: np.ndarray, depth: np.ndarray, config: PipelineConfig, width: int,
+                image_sides: tuple[bool, bool, bool, bool] = (True, True, True, True)) -> np.ndarray:
     """``mask`` without its pixels that see through the front; ``width``: the image's width (``mask``
-    and ``depth`` may be a crop of it), which scales ``fusion.through_band_px``."""
+    and ``depth`` may be a crop of it, whose ``image_sides`` (top, bottom, left, right) are the image's
+    border), which scales ``fusion.through_band_px``."""
     band = scaled_px(config.fusion.through_band_px, width)
     if config.fusion.through_band_px <= 0:
         return mask
-    return mask & ~through_pixels(mask, depth, max(1, band), config.clip.keep_behind_m)
+    return mask & ~through_pixels(mask, depth, max(1, band), config.clip.keep_behind_m, image_sides=image_sides)
 
 
 def prepare_mask(mask: np.ndarray, shape: tuple[int, int], config: PipelineConfig, depth: np.ndarray | None = None) -> np.ndarray:

@@ -137,7 +137,8 @@ def resegment(
         return np.zeros(0, np.int64), mask
     box = (int(xs[0]), int(ys[0]), int(xs[-1]) + 1, int(ys[-1]) + 1)
     crop, Kc = render_crop(rasterizer, frame, box)
-    mc = not_through(m[box[1] : box[3], box[0] : box[2]], crop.depth, config, W)
+    mc = not_through(m[box[1] : box[3], box[0] : box[2]], crop.depth, config, W,
+                     (box[1] == 0, box[3] == H, box[0] == 0, box[2] == W))
     vis = crop.face_ids[mc]
     faces = [np.unique(vis[vis >= 0])]
     faces.append(hidden_behind(mesh, centroids, Kc, frame.w2c, crop, mc, config.clip.keep_behind_m))

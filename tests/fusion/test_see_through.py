@@ -60,6 +60,19 @@ def test_through_pixels_by_hand_on_a_tilted_front():
     assert not through_pixels(mask, z0, 3, 0.03)[30, 40]
 
 
+def test_a_front_cut_off_by_the_image_border_has_no_outline_there():
+    z, mask, reg = glass_door_depth()
+    z, mask = z[20:], mask[20:]  # the image starts at the pane's top: the mask runs into the border there
+    want = np.zeros(mask.shape, bool)
+    want[0:20, 25:55] = True
+    want[2:6, 30:34] = False  # the handle
+    want[15:18, 45:50] = False  # the pane return
+    assert np.array_equal(through_pixels(mask, z, 3, 0.03), want)
+    # a crop whose top is not the image's border: the top rows are outline (on the pane), never through
+    inner = through_pixels(mask, z, 3, 0.03, image_sides=(False, True, True, True))
+    assert not inner[0:3].any() and np.array_equal(inner[3:], want[3:])
+
+
 def test_through_pixels_ignore_bleed_in_the_band_and_leave_solid_fronts_alone():
     z, mask, reg = glass_door_depth()
     bled = z.copy()
