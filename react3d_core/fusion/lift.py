@@ -64,7 +64,8 @@ class FrameLift:
 
 
 def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: float, min_band: int = 12,
-                   image_sides: tuple[bool, bool, bool, bool] = (True, True, True, True)) -> np.ndarray:
+                   image_sides: tuple[bool, bool, bool, bool] = (True, True, True, True), min_inliers: float = 0.7,
+                   min_spread: float = 1.0) -> np.ndarray:
     """Pixels of ``mask`` whose surface (``depth``, metres, 0 = none) lies more than ``behind_m`` behind
     the plane of the mask's outline: the ``band_px`` wide band inside the mask's edge. Where the mask
     runs into the image's border it is cut off, not outlined: ``image_sides`` (top, bottom, left,
@@ -75,8 +76,14 @@ def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: 
     likewise reach what lies behind. The outline of a front lies on the front (frame, edges), so its
     plane tells what is seen through. A plane is affine in inverse depth over pixel coordinates
     (1/z = a u + b v + c for any pinhole camera), fitted by least squares and trimmed twice; no
-    intrinsics needed. Pixels in front of the plane (handles) are never through. Masks with fewer than
-    ``min_band`` band pixels with depth, or a fit that is not in front of the camera, give no pixels.
+    intrinsics needed. Pixels in front of the plane (handles) are never through.
+
+    The outline must tell a plane: at least ``min_band`` band pixels with depth, ``min_inliers`` of them
+    within ``behind_m`` of the fit, spread over ``min_spread`` x ``band_px`` (standard deviation) both
+    ways (a mask cut off by the image on three sides has one edge of outline, a line, through which
+    any plane fits), and the fit in front of the camera. A through region is a panel, not a sliver:
+    only connected regions holding a pixel ``band_px`` from their edge count (a front seen at a grazing
+    angle, or one whose faces reach a few cm deep, has thin strips off any plane).
     """
     m = np.asarray(mask, bool)
     out = np.zeros(m.shape, bool)
@@ -109,7 +116,10 @@ def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: 
         wfit = A @ coef
         zfit = np.divide(1.0, wfit, out=np.full_like(wfit, np.inf), where=wfit > 0)
         keep = np.abs(zb - zfit) < tol
-    if coef is None:
+    if coef is None or keep.mean() < min_inliers:
+        return out
+    spread = np.linalg.eigvalsh(np.cov(np.stack([bx[keep], by[keep]]).astype(np.float64)))
+    if np.sqrt(max(float(spread[0]), 0.0)) < min_spread * band_px:
         return out
     iy, ix = np.nonzero(inner)
     w = coef[0] * ix + coef[1] * iy + coef[2]
@@ -117,7 +127,11 @@ def through_pixels(mask: np.ndarray, depth: np.ndarray, band_px: int, behind_m: 
         return out
     zi = z[iy, ix].astype(np.float64)
     thr = np.nonzero(zi > 1.0 / w + behind_m)[0]
-    out[y0 + iy[thr], x0 + ix[thr]] = True
+    th = np.zeros(mc.shape, np.uint8)
+    th[iy[thr], ix[thr]] = 1
+    n, lab = cv2.connectedComponents(th, connectivity=8)
+    core = np.unique(lab[erode(th.astype(bool), band_px)])
+    out[y0:y1, x0:x1] = np.isin(lab, core[core > 0])
     return out
 
 

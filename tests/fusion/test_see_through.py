@@ -89,6 +89,27 @@ def test_through_pixels_ignore_bleed_in_the_band_and_leave_solid_fronts_alone():
     assert not through_pixels(tiny, z, 3, 0.03).any()
 
 
+def test_no_plane_from_an_outline_that_is_a_line_or_two_planes_and_no_slivers():
+    v, u = np.mgrid[0:H, 0:W].astype(float)
+    z = (1.2 + 0.01 * v + 0.004 * u).astype(np.float32)  # a plane seen at a slant
+    mask = np.zeros((H, W), bool)
+    mask[:, 20:] = True  # cut off by the image at the top, bottom and right: one edge of outline
+    deep = z.copy()
+    deep[10:50, 40:70] += 0.3
+    assert not through_pixels(mask, deep, 3, 0.03).any()
+    box = np.zeros((H, W), bool)
+    box[10:50, 15:65] = True
+    two = z.copy()
+    two[:, 40:] += 0.2  # the right half of the outline lies on another surface 20 cm back
+    assert not through_pixels(box, two, 3, 0.03).any()
+    sliver = z.copy()
+    sliver[15:45, 39:41] += 0.1  # a 2 px strip off the plane (faces reaching a few cm deep): no panel
+    assert not through_pixels(box, sliver, 3, 0.03).any()
+    sliver[15:45, 30:38] += 0.1  # an 8 px wide region is a panel
+    got = through_pixels(box, sliver, 3, 0.03)
+    assert got[15:45, 30:38].all() and got.sum() == 30 * 8
+
+
 # -- a glass-panel door in front of a cabinet's inside, rendered ------------------------------
 RING = 0.08  # frame width (m)
 
