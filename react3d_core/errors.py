@@ -17,6 +17,11 @@ class InputError(React3DError):
         self.problem = problem
         super().__init__(f"{path}: {problem}" if path is not None else problem)
 
+    def __reduce__(self) -> tuple[type, tuple[Path | None, str]]:
+        """Rebuilt from (path, problem) when it crosses a process boundary (a benchmark's scene worker):
+        the default rebuilds from the message alone and failed, leaving the parent waiting for ever."""
+        return type(self), (self.path, self.problem)
+
 
 class ConfigError(React3DError):
     """Invalid pipeline configuration (unknown backend, out-of-range threshold, ...)."""

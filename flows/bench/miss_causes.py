@@ -96,11 +96,13 @@ def trace_scene(scene_path: str, manifest_path: str, config: dict[str, Any]) -> 
     sets: dict[str, list[np.ndarray]] = {"raw": [], "filled": [], "lifted": []}
     pix: dict[str, list[np.ndarray]] = {"raw": [], "filled": [], "lifted": []}
     for f in scene.frames:
-        ids = render_work(rast, f, cfg).face_ids
+        r = render_work(rast, f, cfg)
+        ids = r.face_ids
         seen.append(np.unique(ids))
         for mk in masks.get(f.frame_id, []):
-            for kind, m in (("raw", resize_mask(mk.mask, ids.shape)), ("filled", filled(mk.mask, ids.shape, cfg)),
-                            ("lifted", prepare_mask(mk.mask, ids.shape, cfg))):
+            fm = filled(mk.mask, ids.shape, cfg, r.depth)  # without what is seen through the front, as lifted
+            for kind, m in (("raw", resize_mask(mk.mask, ids.shape) & fm), ("filled", fm),
+                            ("lifted", prepare_mask(mk.mask, ids.shape, cfg, r.depth))):
                 under = ids[m]
                 fs, px = np.unique(under[under >= 0], return_counts=True)
                 sets[kind].append(fs.astype(np.int64))

@@ -9,6 +9,7 @@ class FusionConfig(StageConfig):
     """Multi-view 2D->3D fusion through a face co-occurrence graph and Louvain communities."""
 
     erode_px: int = Field(4, ge=0, description="Erode each mask by this many px before collecting faces (boundary bleed).")
+    through_band_px: int = Field(9, ge=0, description="A mask's front plane is fitted to its pixels within this many px of its outline; pixels whose surface lies more than clip.keep_behind_m behind it are seen through the front (a glass pane the scan lacks) and not lifted (0: off).")
     min_cooccurrence: int = Field(3, ge=1, description="Edge in the face graph if a face pair co-occurs in >= this many masks.")
     max_pairs_per_mask: int = Field(20000, ge=1, description="Cap on sampled face pairs per mask (keeps cost linear).")
     resolutions: tuple[float, ...] = Field((0.5, 1.0, 5.0, 50.0, 500.0), description="Louvain resolutions swept.")

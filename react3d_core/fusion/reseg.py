@@ -23,7 +23,7 @@ from ..camera import project, scaled_px
 from ..raster import Rasterizer
 from ..raster.rasterizer import RasterResult
 from .connectivity import largest_component
-from .lift import erode, fill_holes, resize_mask
+from .lift import erode, filled, not_through
 
 
 def point_prompts(silhouette: np.ndarray, n_pos: int = 3, n_neg: int = 4) -> tuple[np.ndarray, np.ndarray]:
@@ -107,7 +107,7 @@ def resegment(
     centroids: np.ndarray,
     proposal_faces: np.ndarray,
     top_views: Sequence[TopView],
-    buffers: dict[str, np.ndarray],
+    buffers: dict[str, RasterResult],
     point_segmenter: PointPromptSegmenter,
     rasterizer: Rasterizer,
     config: PipelineConfig,
@@ -117,10 +117,11 @@ def resegment(
     Prompts come from the proposal's silhouette in the working-resolution buffer; the mask is
     back-projected at full resolution (only its bounding box is rendered): visible faces under it,
     faces hidden right behind it (slab), and faces this view cannot see under the other top-k
-    masks; then the largest connected component (+ attached handles).
+    masks; then the largest connected component (+ attached handles). Pixels that see through the
+    front (:func:`.lift.through_pixels`) are left out of every mask.
     """
     W, H = frame.intrinsics.width, frame.intrinsics.height
-    ids_w = buffers[frame.frame_id]
+    ids_w = buffers[frame.frame_id].face_ids
     in_prop = np.zeros(mesh.n_faces + 1, bool)
     in_prop[proposal_faces] = True
     sil = in_prop[ids_w]  # -1 -> last slot (False)
@@ -130,14 +131,14 @@ def resegment(
     mask = point_segmenter.segment_points(frame, _image(frame), pts, lab) if len(pts) else None
     if mask is None or mask.area == 0:
         mask = top_views[0].mask
-    m = fill_holes(resize_mask(mask.mask, (H, W)), config.perception.hole_close_px)
-    m = erode(m, max(1, scaled_px(config.fusion.erode_px, W) // 2))
+    m = erode(filled(mask.mask, (H, W), config), max(1, scaled_px(config.fusion.erode_px, W) // 2))
     ys, xs = np.nonzero(m.any(1))[0], np.nonzero(m.any(0))[0]
     if not len(ys):
         return np.zeros(0, np.int64), mask
     box = (int(xs[0]), int(ys[0]), int(xs[-1]) + 1, int(ys[-1]) + 1)
     crop, Kc = render_crop(rasterizer, frame, box)
-    mc = m[box[1] : box[3], box[0] : box[2]]
+    mc = not_through(m[box[1] : box[3], box[0] : box[2]], crop.depth, config, W,
+                     (box[1] == 0, box[3] == H, box[0] == 0, box[2] == W))
     vis = crop.face_ids[mc]
     faces = [np.unique(vis[vis >= 0])]
     faces.append(hidden_behind(mesh, centroids, Kc, frame.w2c, crop, mc, config.clip.keep_behind_m))
@@ -148,9 +149,9 @@ def resegment(
     for tv in top_views:  # faces hidden from the segmenting view, seen under the part's other masks
         if tv.frame_id == frame.frame_id or tv.mask is None or tv.frame_id not in buffers:
             continue
-        ids = buffers[tv.frame_id]
-        mm = erode(fill_holes(resize_mask(tv.mask.mask, ids.shape), config.perception.hole_close_px),
-                   scaled_px(config.fusion.erode_px, ids.shape[1]))
+        buf = buffers[tv.frame_id]
+        ids = buf.face_ids
+        mm = erode(filled(tv.mask.mask, ids.shape, config, buf.depth), scaled_px(config.fusion.erode_px, ids.shape[1]))
         f = ids[mm]
         f = f[f >= 0]
         faces.append(f[~seen[f]])

@@ -57,16 +57,16 @@ def render_work(rasterizer: Rasterizer, frame: Frame, config: PipelineConfig) ->
 
 def lift_frames(
     scene: SceneInput, masks: Mapping[str, Sequence[Mask2D]], rasterizer: Rasterizer, config: PipelineConfig
-) -> tuple[list[FrameLift], dict[str, np.ndarray], list[ViewStats]]:
+) -> tuple[list[FrameLift], dict[str, RasterResult], list[ViewStats]]:
     """Render each frame with masks once (working width), lift its masks and collect its top-k
-    statistics; keeps the buffers for re-segmentation prompts."""
+    statistics; keeps the buffers (face ids, depth) for re-segmentation."""
     lifts, buffers, stats = [], {}, []
     for f in scene.frames:
         ms = masks.get(f.frame_id)
         if not ms:
             continue
         r = render_work(rasterizer, f, config)
-        buffers[f.frame_id] = r.face_ids
+        buffers[f.frame_id] = r
         lift, st = lift_with_stats(r, list(ms), config)
         lifts.append(lift)
         stats.append(st)
@@ -111,7 +111,7 @@ def candidates_from_proposals(
     scene: SceneInput,
     mesh: TriMesh,
     proposals: Sequence[Proposal],
-    buffers: dict[str, np.ndarray],
+    buffers: dict[str, RasterResult],
     stats: Sequence[ViewStats],
     masks: Mapping[str, Sequence[Mask2D]],
     point_segmenter: PointPromptSegmenter,

@@ -16,11 +16,11 @@ from a traced run), in pipeline order; the first stage after which no output sti
 ``not_masked``             fewer than ``cause_min_views`` 2D masks lie on the part (perception; judged on
                            the GT part-id images where the scene has them, else on the scan's faces)
 ``off_scan_surface``       masked in the images, but in the scan the masks lie mostly on other surface:
-                           the part is not where the images show it (a glass panel missing from the
-                           scan shows the cabinet's inside; colour misregistered against the mesh)
-``filled_through``         masked, but hole filling (meant for missed handles) pulls in what lies
-                           behind the mask's holes, so the filled masks are mostly other surface: a
-                           frame-only (glass-panel) door is lifted with the cabinet's inside
+                           the part is not where the images show it (colour misregistered against the
+                           mesh). Pixels seen through the front (a glass pane missing from the scan
+                           shows the cabinet's inside) are left out of every mask, as lifting does
+``filled_through``         masked, but hole filling (meant for missed handles) pulls in other surface
+                           within the front's slab, so the filled masks are mostly other surface
 ``lost_in_lifting``        masked often enough, but fewer masks survive lifting (erosion, occlusion),
                            or the lifted faces cover under half of the part
 ``lost_in_fusion``         lifted, but no Louvain proposal is the part, merged or split (graph too weak)

@@ -17,6 +17,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     (handles.protrusion_from_surface), and a handle has the plane's outline on both long sides (handles.side_cover)
 # (per-view colour registration, registration.sigmas_px, is opt-in: off it changes nothing, and the
 # configuration a run uses is part of the cache key)
-HEURISTIC_VERSION = "14"
+# 15: holes in a plane's coverage framed all round by a door-frame wide band count as covered (glass
+#     panes the scan lacks; image.pane_*)
+HEURISTIC_VERSION = "15"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

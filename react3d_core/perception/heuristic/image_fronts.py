@@ -146,6 +146,34 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
     return keep[lab]
 
 
+def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float) -> np.ndarray:
+    """Holes in a plane's coverage ``cov`` framed all round by the plane's surface: each hole (8-connected,
+    not touching the grid's border) of at least ``min_area`` m² whose ``frame`` m wide band around it is
+    covered by at least ``cover``.
+
+    Why: a glass-panel door is a frame around a pane the scan mostly lacks (the sensor sees through it),
+    so on its plane it is a ring; the door spans the ring and the pane. A gap between two fronts or an
+    open shelf beside a front is no hole framed all round by a door-frame wide band of surface."""
+    out = np.zeros(cov.shape, bool)
+    r = int(round(frame / res))
+    if frame <= 0 or r < 1 or not cov.any():
+        return out
+    hole = (~cov).astype(np.uint8)
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(hole, connectivity=CONNECTIVITY)
+    h, w = cov.shape
+    x, y, bw, bh, area = (stats[:, k] for k in (cv2.CC_STAT_LEFT, cv2.CC_STAT_TOP, cv2.CC_STAT_WIDTH,
+                                                 cv2.CC_STAT_HEIGHT, cv2.CC_STAT_AREA))
+    cand = np.flatnonzero((area * res ** 2 >= min_area) & (x > 0) & (y > 0) & (x + bw < w) & (y + bh < h))
+    kern = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
+    for k in cand[cand > 0]:  # label 0: the covered pixels
+        y0, y1, x0, x1 = max(y[k] - r, 0), min(y[k] + bh[k] + r, h), max(x[k] - r, 0), min(x[k] + bw[k] + r, w)
+        me = (lab[y0:y1, x0:x1] == k).astype(np.uint8)
+        band = cv2.dilate(me, kern).astype(bool) & ~me.astype(bool)
+        if band.any() and cov[y0:y1, x0:x1][band].mean() >= cover:
+            out[y0:y1, x0:x1] |= me.astype(bool)
+    return out
+
+
 def cov_outline(cov: np.ndarray, px: int) -> np.ndarray:
     """The plane's outline with holes and notches up to ``px`` wide filled: a pixel is inside when
     the plane is within ``px`` on both sides of it along a row or along a column (a handle's scanning
@@ -292,6 +320,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         else:
             cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
+        cov = cov | framed_panes(cov, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area)
         diff = off_background(o, hc)
         diffs.append(diff)
         outline = cov_outline(cov, cfg.image.outline_fill_px)  # handle shadows are holes in the plane, not its outline
