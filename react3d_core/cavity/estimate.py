@@ -187,12 +187,45 @@ def wall_thickness(pf: PartFrame, cfg: CavityConfig) -> float:
     return max(cfg.min_wall_m, cfg.wall_factor * min(pf.su, pf.sv))
 
 
+def level_frame(pf: PartFrame, within_deg: float, up: np.ndarray = UP) -> tuple[PartFrame, float]:
+    """The part frame turned so that its normal is exactly horizontal (or vertical) when it is within
+    ``within_deg`` of it, about the axis that moves it least, and ``reach``: how far behind the centre
+    (along the front's own normal) the turned outline's corners lie at most; a carcass starting
+    ``(gap + reach) / cos`` deep along the new normal (``cos`` between the two normals) stays ``gap`` behind
+    the front's back face everywhere. Fronts further off (a sloped panel) keep their frame."""
+    up = np.asarray(up, float) / np.linalg.norm(up)
+    n = np.asarray(pf.n, float)
+    c = float(n @ up)
+    sin_lim = np.sin(np.radians(within_deg))
+    if abs(c) <= sin_lim:
+        target = n - c * up
+    elif np.sqrt(max(0.0, 1.0 - c * c)) <= sin_lim:
+        target = np.sign(c) * up
+    else:
+        return pf, 0.0
+    target = target / np.linalg.norm(target)
+    k = np.cross(n, target)
+    s = float(np.linalg.norm(k))
+    if s < 1e-12:
+        return pf, 0.0
+    k /= s
+    cos = float(n @ target)
+    K = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
+    R = np.eye(3) + s * K + (1 - cos) * (K @ K)
+    u, v = R @ pf.u, R @ pf.v
+    reach = 0.5 * pf.su * abs(float(u @ n)) + 0.5 * pf.sv * abs(float(v @ n))
+    return PartFrame(pf.center, u, v, target, pf.su, pf.sv, pf.thickness), reach
+
+
 def base_mesh(pf: PartFrame, depth: float, cfg: CavityConfig, gap: float = 0.002) -> TriMesh:
-    """Open-front box behind the front: back wall and four side walls with real thickness."""
+    """Open-front box behind the front: back wall and four side walls with real thickness, built level
+    (``level_frame``) so that what is put on its floor stays in."""
+    o, n = pf.back, pf.n
+    pf, reach = level_frame(pf, cfg.level_within_deg)
     w = wall_thickness(pf, cfg)
     hu, hv = pf.su / 2, pf.sv / 2
-    c0, c1 = gap, gap + depth
-    o = pf.back
+    c0 = (gap + reach) / float(n @ pf.n)
+    c1 = max(gap + depth, c0 + 2 * w)
     boxes = [
         _box(np.array([-hu, -hv, c1 - w]), np.array([hu, hv, c1]), pf, o),
         _box(np.array([-hu, -hv, c0]), np.array([-hu + w, hv, c1 - w]), pf, o),

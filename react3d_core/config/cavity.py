@@ -23,3 +23,6 @@ class CavityConfig(StageConfig):
     body_side_reach_m: float = Field(0.1, ge=0, description="d_body, where neither the up- nor the down-rays end: sideways rays "
                                                            "count only if they hit a side panel within half the front's width "
                                                            "+ this (the part's own carcass, not a neighbour or the room).")
+    level_within_deg: float = Field(10.0, ge=0, le=45, description="A carcass behind a front whose normal is within this angle (degrees) "
+                                                                   "of horizontal (or vertical) is built level: a front estimated a degree "
+                                                                   "off plumb must not tilt the cavity's floor towards the room.")

@@ -6,7 +6,7 @@ from ._base import StageConfig
 
 
 class DedupConfig(StageConfig):
-    """Two-stage duplicate removal."""
+    """Duplicate removal: overlapping, merged, fragment, sliver and same-motion pieces."""
 
     tau_dup: float = Field(0.5, ge=0, le=1, description="Stage 1: pairwise IoU >= this -> keep the larger part.")
     tau_low: float = Field(0.2, ge=0, le=1, description="Stage 2: smaller parts with IoU >= this are cover candidates.")
@@ -15,3 +15,7 @@ class DedupConfig(StageConfig):
     tau_contained: float = Field(0.7, ge=0, le=1, description="Stage 3: remove a part with this share of its vertices inside one larger kept part (a fragment).")
     fragment_share: float = Field(0.25, ge=0, le=1, description="Stage 4: a part at most this share of a larger kept part's size (vertices) ...")
     footprint_margin_m: float = Field(0.01, ge=0, description="... with tau_contained of its points inside that part's box grown by this (m) is a sliver of it.")
+    motion_share: float = Field(0.5, ge=0, le=1, description="Stage 5: a smaller part with this share of its front's footprint inside a larger kept part's front (in its slab) that moves the same way is a piece of it and merged into it.")
+    motion_angle_deg: float = Field(10.0, ge=0, le=90, description="Stage 5: same motion = same joint type with axes and front normals within this angle (degrees) ...")
+    motion_hinge_m: float = Field(0.05, ge=0, description="... and, for hinges, axis lines within this distance (m): a piece's hinge is estimated from its own box, a few cm off its door's.")
+    motion_slab_m: float = Field(0.03, ge=0, description="Stage 5: the footprint counts only within this distance (m) of the larger part's slab along its normal.")

@@ -42,6 +42,9 @@ class PhysicsConfig(StageConfig):
     probe_mass_kg: float = Field(0.1, gt=0, description="Probe sphere mass.")
     probe_speed: float = Field(0.5, gt=0, description="Speed at which the front probe is pushed at a closed front (m/s), a gripper's approach.")
     cavity_probe_s: float = Field(1.0, gt=0, description="Time the cavity probe is left to fall and settle (s).")
+    cavity_drop_m: float = Field(0.1, gt=0, description="The cavity probe falls from at most this height above the cavity's floor (m), as an object is put "
+                                                       "into a cupboard (the cavity's centre is still checked for clearance): dropped from a tall "
+                                                       "cavity's centre, a small probe hits at 2-3 m/s and MuJoCo's soft contact lets it sink through a 1.5 cm board.")
     front_probe_s: float = Field(0.4, gt=0, description="Time the front probe flies and bounces (s); longer for a deep front, so that an unhindered probe ends 5 cm past its back face.")
 
     @field_validator("engines")

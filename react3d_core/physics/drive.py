@@ -232,26 +232,36 @@ def _probe_loop(sim: Sim, q_hold: np.ndarray, seconds: float, cfg: PhysicsConfig
 
 
 def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
-    """The joint held at its goal; a sphere placed in the cavity falls. Free: placed clear of every collider
-    (<= 1 mm), ends inside the cavity (moved with the joint's final value for a drawer) and came down at
-    least half way to the cavity's bottom. Its deepest penetration is recorded, not judged: on impact a
-    soft contact (MuJoCo's) lets it sink a centimetre into a floor for a few steps."""
+    """The joint held at its goal; a sphere placed at the cavity's centre for one step (held there), then
+    dropped from straight below it, at most ``cavity_drop_m`` above the floor. Free: placed clear of every
+    collider both times (<= 1 mm), ends inside the cavity (moved with the joint's final value for a
+    drawer) and came down at least half way to the cavity's bottom or rests on nothing but the object's own
+    bodies (its carcass floor, the drawer's box). Its deepest penetration is recorded,
+    not judged: on impact a soft contact (MuJoCo's) lets it sink a few millimetres into a floor."""
     j = sim.joints[i]
     goal = goal_of(j)
-    plan = cavity_probe(f, cfg.probe_radius_m)
+    plan = cavity_probe(f, cfg.probe_radius_m, drop=cfg.cavity_drop_m)
     q = np.zeros(len(sim.joints))
     q[i] = goal
     sim.reset(q)
+    sim.add_probe(plan.center, np.zeros(3), plan.radius, cfg.probe_mass_kg, gravity=False)
+    at_center, spawn_c = _probe_loop(sim, q, sim.dt, cfg)
+    sim.reset(q)
     sim.add_probe(plan.spawn, np.zeros(3), plan.radius, cfg.probe_mass_kg, gravity=True)
     log, spawn = _probe_loop(sim, q, cfg.cavity_probe_s, cfg)
+    if spawn_c > spawn:
+        spawn, log = spawn_c, at_center
     end = sim.probe()[0]
     q_end = float(sim.state()[0][i])
     box = plan.box
     if f.moving_cavity:
         box = cavity_box(f).moved(f.articulation, q_end)
     inside = bool(np.all(np.isfinite(end))) and box.contains(end)
-    fell = inside and fell_enough(box, plan.spawn, end, plan.radius)
     touched = log.touches(by_depth=False)
+    # resting on the cavity's own floor (its carcass, or the drawer's box) is where it should land, however
+    # far above the front's lower edge clearance put that floor
+    own = {j.link, f"{j.link}_base"}
+    fell = inside and (fell_enough(box, plan.spawn, end, plan.radius) or bool(touched and {t.body for t in touched} <= own))
     cause = None
     if spawn > SPAWN_TOL:
         where = max(log.depth, key=log.depth.get) if log.depth else "?"

@@ -105,25 +105,38 @@ def probe_radius(f: Front, radius: float) -> float:
 
 @dataclass(frozen=True)
 class CavityProbe:
-    spawn: np.ndarray
+    spawn: np.ndarray  # where it is dropped from
     box: CavityBox  # at the open joint value
     radius: float
+    center: np.ndarray  # the point it is first placed at, to see the space is clear (``spawn`` before lowering)
 
 
-def cavity_probe(f: Front, radius: float, margin: float = 0.01) -> CavityProbe:
-    """Where the probe is dropped with the joint at its goal: a door's cavity at its centre; a drawer's in
+def lowered(p: np.ndarray, box: CavityBox, r: float, drop: float | None, up: np.ndarray = UP) -> np.ndarray:
+    """``p`` moved straight down until its lowest point is at most ``drop`` above the box's lowest corner
+    (unchanged when it already is, or with no ``drop``)."""
+    if drop is None:
+        return p
+    bottom = float((box.corners() @ up).min())
+    excess = float(np.dot(p, up)) - r - bottom - drop
+    return p - up * excess if excess > 0 else p
+
+
+def cavity_probe(f: Front, radius: float, margin: float = 0.01, drop: float | None = None) -> CavityProbe:
+    """Where the probe is placed with the joint at its goal: a door's cavity at its centre; a drawer's in
     the middle of the part of it pulled out of the body (centre height), at least ``radius + margin``
-    from its front and back."""
+    from its front and back. It is dropped from straight below that point, at most ``drop`` above the
+    cavity's floor (``lowered``)."""
     r = probe_radius(f, radius)
     box = cavity_box(f)
     if not f.moving_cavity:
-        return CavityProbe(box.center, box, r)
+        return CavityProbe(lowered(box.center, box, r, drop), box, r, box.center)
     a = f.articulation
     d = float(f.cavity_depth or 0.0)
     out = abs(f.goal) * max(0.0, -float(np.dot(a.axis, f.n)) * np.sign(f.goal)) if a.joint_type == "prismatic" else d
     s = float(np.clip(min(out, d) / 2, r + margin, max(r + margin, d - r - margin)))
-    p = f.back + f.n * s
-    return CavityProbe(a.move(p[None], f.goal)[0], box.moved(a, f.goal), r)
+    p = a.move((f.back + f.n * s)[None], f.goal)[0]
+    moved = box.moved(a, f.goal)
+    return CavityProbe(lowered(p, moved, r, drop), moved, r, p)
 
 
 def fell_enough(box: CavityBox, spawn: np.ndarray, end: np.ndarray, r: float, up: np.ndarray = UP) -> bool:

@@ -14,7 +14,8 @@ from react3d_core.assembly.scene import _Geometry
 from react3d_core.cavity import PartFrame, base_mesh, d_hit, d_mesh, estimate_cavity
 from react3d_core.config import CavityConfig, DedupConfig, LimitConfig
 from react3d_core.data.parts import OBB, Articulation
-from react3d_core.dedup import dedup_indices
+from react3d_core.dedup import dedup_indices, remove_duplicates
+from react3d_core.dedup.remove import dedup_plan, footprint_share, grown_box
 from react3d_core.geometry import overlap_counts
 from react3d_core.synthetic.builder import MeshBuilder
 
@@ -52,6 +53,45 @@ def test_cavity_depth_of_a_box_cabinet() -> None:
     assert lo[1] == pytest.approx(-0.002 + 0.002, abs=1e-9) and hi[1] == pytest.approx(-0.002 + 0.002 + d, abs=1e-9)
     # every base face points away from its box: a closed, double-walled box (walls have thickness)
     assert base.n_faces == 5 * 12
+
+
+def test_carcass_behind_a_front_off_plumb_is_level_and_clear_of_it() -> None:
+    """A door 0.8 m tall estimated 1 degree off plumb (normal into the cavity tilted up by 1 degree): its
+    carcass floor is level (the bottom board's 4 top corners at one height), it starts behind the front's
+    back face everywhere within the outline (>= the 2 mm gap; by hand the level top edge lies
+    0.4 sin 1 deg = 7.0 mm in front of the tilted back plane, so the carcass starts (2 + 7.0) / cos 1 deg
+    = 9.0 mm behind the centre), and
+    its back wall stays where the cavity depth puts it. A front 20 degrees off keeps its frame; a
+    front within 1 degree of facing down (a flap under a worktop) is made to face exactly down."""
+    from react3d_core.cavity.estimate import level_frame
+
+    a = np.radians(1.0)
+    n = np.array([0.0, np.cos(a), np.sin(a)])
+    u = np.array([0.0, -np.sin(a), np.cos(a)])  # the front's height axis, tilted with it
+    pf = PartFrame(center=np.array([0.3, 0.0, 0.4]), u=u, v=np.array([1.0, 0.0, 0.0]), n=n, su=0.8, sv=0.6, thickness=0.02)
+    cfg = CavityConfig()
+    base = base_mesh(pf, 0.5, cfg)
+    w = 0.6 * cfg.wall_factor
+    V = base.vertices.reshape(-1, 8, 3)  # five boxes of 8 corners: back, two sides, bottom and top boards
+    boards = [b for b in V if np.ptp(b[:, 2]) == pytest.approx(w, abs=1e-9)]
+    assert len(boards) == 2
+    bottom = min(boards, key=lambda b: b[:, 2].min())
+    top_face = bottom[np.isclose(bottom[:, 2], bottom[:, 2].max())]
+    assert len(top_face) == 4 and np.ptp(top_face[:, 2]) < 1e-12
+    back = pf.back
+    inside = (np.abs((base.vertices - back) @ pf.v) <= 0.3 + 1e-9)
+    behind = (base.vertices - back) @ n
+    assert behind[inside].min() >= 0.002 - 1e-9
+    level, reach = level_frame(pf, cfg.level_within_deg)
+    assert reach == pytest.approx(0.4 * np.sin(a), abs=1e-12) and np.allclose(level.n, (0, 1, 0))
+    assert ((base.vertices - back) @ level.n).min() == pytest.approx((0.002 + 0.4 * np.sin(a)) / np.cos(a), abs=1e-9)
+    assert ((base.vertices - back) @ level.n).max() == pytest.approx(0.502, abs=1e-9)
+    b = np.radians(20.0)
+    steep = PartFrame(pf.center, np.array([0.0, -np.sin(b), np.cos(b)]), pf.v, np.array([0.0, np.cos(b), np.sin(b)]), 0.8, 0.6, 0.02)
+    assert level_frame(steep, cfg.level_within_deg) == (steep, 0.0)
+    c = np.radians(0.5)
+    flap = PartFrame(pf.center, np.array([0.0, np.cos(c), np.sin(c)]), pf.v, np.array([0.0, np.sin(c), -np.cos(c)]), 0.4, 0.6, 0.02)
+    assert np.allclose(level_frame(flap, cfg.level_within_deg)[0].n, (0, 0, -1))
 
 
 def test_dedup_stage1_keeps_the_larger() -> None:
@@ -105,6 +145,70 @@ def test_dedup_stage4_removes_a_sliver_inside_a_larger_parts_box() -> None:
     proud = sliver_pts + [0, -0.05, 0]
     assert dedup_indices(sets, cfg, [door_pts, proud, nb_pts], [door_box, sliver_box, nb_box]) == [0, 1, 2]
     assert dedup_indices(sets, cfg) == [0, 1, 2]
+
+
+def _door_part(pid: int, vids: np.ndarray, box: OBB, art: Articulation, normal=(0.0, 1.0, 0.0)) -> ArticulatedPart:
+    return ArticulatedPart(candidate_id=pid, label="door", score=0.5, face_ids=vids.copy(), vertex_ids=vids, initial=art,
+                           articulation=art, obb=box, front_normal=np.array(normal), thickness=0.02, flat=True)
+
+
+def test_dedup_stage5_merges_a_piece_that_moves_with_a_larger_part() -> None:
+    """A door (x 0..0.5, z 0..0.7, front plane y = 0, hinged on its left edge about -z) and a strip fusion
+    split off its bottom-left (x 0..0.12, z -0.15..0.15, vertices of its own, the same hinge): half its
+    points and 5/9 of its footprint grid lie in the door, so stages 3 and 4 keep it; stage 5 merges it into
+    the door, whose box grows down to z = -0.15 (area share by hand: rows z = c + t * 0.3 with
+    t = (k + 0.5) / 9 - 0.5 inside z >= -0.01 for k = 4..8, i.e. 5 of 9). The same strip hinged on the right
+    edge, or as a drawer, stays; so do a door stacked above on the same hinge line and a neighbour."""
+    rng = np.random.default_rng(1)
+    ax = ((0, 0, 1), (1, 0, 0), (0, 1, 0))
+    door_pts = np.c_[rng.uniform(0, 0.5, 400), rng.uniform(-0.01, 0.01, 400), rng.uniform(0, 0.7, 400)]
+    door_box = OBB(center=(0.25, 0.0, 0.35), axes=ax, extents=(0.7, 0.5, 0.02))
+    strip_pts = np.c_[rng.uniform(0, 0.12, 60), rng.uniform(-0.01, 0.01, 60), np.linspace(-0.15, 0.15, 60)]
+    strip_box = OBB(center=(0.06, 0.0, 0.0), axes=ax, extents=(0.3, 0.12, 0.02))
+    above_pts = door_pts + [0, 0, 0.72]
+    above_box = OBB(center=(0.25, 0.0, 1.07), axes=ax, extents=(0.7, 0.5, 0.02))
+    nb_pts = door_pts + [0.52, 0, 0]
+    nb_box = OBB(center=(0.77, 0.0, 0.35), axes=ax, extents=(0.7, 0.5, 0.02))
+    hinge = Articulation(joint_type="revolute", axis=(0, 0, -1), origin=(0.0, -0.01, 0.35), upper=1.5)
+    right = Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(0.5, -0.01, 0.35), upper=1.5)
+    slide = Articulation(joint_type="prismatic", axis=(0, -1, 0), origin=(0.06, 0.0, 0.0), upper=0.4)
+    nb_hinge = Articulation(joint_type="revolute", axis=(0, 0, 1), origin=(1.02, -0.01, 0.35), upper=1.5)
+    n = np.array([0.0, 1.0, 0.0])
+    sets = [np.arange(400), np.arange(400, 460), np.arange(460, 860), np.arange(860, 1260)]
+    pts, boxes = [door_pts, strip_pts, above_pts, nb_pts], [door_box, strip_box, above_box, nb_box]
+    cfg = DedupConfig()
+    assert dedup_indices(sets, cfg, pts, boxes) == [0, 1, 2, 3]  # stages 1-4 keep the strip
+    motions = [(hinge, n, False), (hinge, n, False), (hinge.model_copy(update={"origin": (0.0, -0.01, 1.07)}), n, False),
+               (nb_hinge, n, False)]
+    assert dedup_plan(sets, cfg, pts, boxes, motions) == ([0, 2, 3], {0: [1]})
+    for other in (right, slide):
+        assert dedup_indices(sets, cfg, pts, boxes, [motions[0], (other, n, False), *motions[2:]]) == [0, 1, 2, 3]
+    assert dedup_indices(sets, cfg, pts, boxes, [motions[0], (hinge, n, True), *motions[2:]]) == [0, 1, 2, 3]
+    assert dedup_indices(sets, cfg.model_copy(update={"motion_share": 0.6}), pts, boxes, motions) == [0, 1, 2, 3]
+    assert abs(footprint_share(strip_box, door_box, 0.01, 0.03) - 5 / 9) < 1e-12
+    assert footprint_share(strip_box.model_copy(update={"center": (0.06, -0.05, 0.0)}), door_box, 0.01, 0.03) == 0.0
+
+    vertices = np.zeros((1260, 3))
+    for s_, p_ in zip(sets, pts):
+        vertices[s_] = p_
+    parts = [_door_part(k, s_, b_, m_[0]) for k, (s_, b_, m_) in enumerate(zip(sets, boxes, motions))]
+    out = remove_duplicates(parts, cfg, vertices)
+    assert [p.candidate_id for p in out] == [0, 2, 3]
+    door = out[0]
+    assert np.array_equal(door.vertex_ids, np.arange(460)) and np.array_equal(door.face_ids, np.arange(460))
+    assert np.allclose(door.obb.center, (0.25, 0.0, 0.275)) and np.allclose(door.obb.extents, (0.85, 0.5, 0.02))
+    assert door.obb.axes == door_box.axes and door.articulation == hinge
+
+
+def test_grown_box_keeps_extents_in_decreasing_order() -> None:
+    """A 0.3 (z) x 0.25 (x) box grown sideways by a piece reaching x = 0.3 spans x -0.125..0.3 = 0.425 (centre
+    0.0875), wider than tall: the axes swap to (v, -u, n)."""
+    box = OBB(center=(0, 0, 0), axes=((0, 0, 1), (1, 0, 0), (0, 1, 0)), extents=(0.3, 0.25, 0.02))
+    piece = OBB(center=(0.2, 0, 0), axes=((0, 0, 1), (1, 0, 0), (0, 1, 0)), extents=(0.1, 0.2, 0.02))
+    g = grown_box(box, [piece])
+    assert np.allclose(g.extents, (0.425, 0.3, 0.02)) and np.allclose(g.center, (0.0875, 0, 0))
+    assert np.allclose(g.axes, ((1, 0, 0), (0, 0, -1), (0, 1, 0)))
+    assert np.allclose(np.cross(g.axes[0], g.axes[1]), g.axes[2])
 
 
 def test_dedup_is_bounded_on_many_overlapping_candidates() -> None:

@@ -164,3 +164,30 @@ def test_a_front_probe_floats_and_a_cavity_probe_falls(clean_out: Path, engine: 
         for _ in range(int(round(0.2 / sim.dt))):
             sim.step(q, q)
         assert start[2] - sim.probe()[0][2] == pytest.approx(drop, abs=0.005), (engine, gravity)
+
+
+def test_a_cavity_probe_resting_on_its_own_floor_has_fallen(clean_out: Path) -> None:
+    """Dropped from 4 mm above the door's carcass floor, the probe cannot come down half of the way to the
+    front's lower edge (the floor board lies between); it rests on the object's own carcass, so the cavity
+    is free. With the fallen rule alone (half way) it would be called held up."""
+    pytest.importorskip("mujoco")
+    from react3d_core.data import InteractiveScene
+    from react3d_core.data.mesh import load_mesh
+    from react3d_core.physics import drive
+    from react3d_core.physics.check import _make
+    from react3d_core.physics.targets import cavity_box, cavity_probe, fell_enough, front_of, match_joints
+
+    scene = InteractiveScene.load(clean_out / "scene.json")
+    obj = next(o for o in scene.objects if o.articulation.joint_type == "revolute")
+    f = front_of(obj)
+    bottom = float(cavity_box(f).corners()[:, 2].min())
+    z = np.unique(np.round(load_mesh(clean_out / obj.base_mesh).vertices[:, 2], 6))
+    floor_top = float(z[1])  # the floor board's top: the second-lowest height of the carcass's boxes
+    assert floor_top - bottom > 0.008
+    cfg = PhysicsConfig(cavity_drop_m=floor_top - bottom + 0.004)
+    sim = _make("mujoco", clean_out / "export/mjcf/scene.xml", cfg)
+    i = next(k for k, j in enumerate(sim.joints) if match_joints([f], [j]))
+    res = drive.cavity(sim, i, f, cfg)
+    assert res.passed and {t.body for t in res.touched} <= {sim.joints[i].link, f"{sim.joints[i].link}_base"}, res
+    plan = cavity_probe(f, cfg.probe_radius_m, drop=cfg.cavity_drop_m)
+    assert not fell_enough(plan.box, plan.spawn, np.array(res.end), plan.radius)

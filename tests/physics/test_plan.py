@@ -52,6 +52,22 @@ def test_drawer_cavity_probe_is_dropped_into_the_pulled_out_part() -> None:
     np.testing.assert_allclose(plan.box.center, [0.3, 0.49 + 0.24 - 0.4, 0.17], atol=1e-12)
 
 
+def test_cavity_probe_is_dropped_from_at_most_the_drop_height() -> None:
+    """The door's cavity spans z 0.03..0.61 (0.32 +- 0.29); a 0.03 m probe at its centre is 0.26 m above
+    the floor: with a 0.1 m drop it falls from z = 0.03 + 0.03 + 0.1 = 0.16, straight below the centre,
+    which is kept as the point checked for clearance. The drawer's probe (z 0.17, cavity floor 0.03) is
+    0.11 m up: lowered by 0.01 to 0.16. A 0.3 m drop leaves both where they were."""
+    f = front_of(DOOR_OBJ)
+    plan = cavity_probe(f, 0.03, drop=0.1)
+    np.testing.assert_allclose(plan.spawn, [-0.75, 0.73, 0.16], atol=1e-12)
+    np.testing.assert_allclose(plan.center, [-0.75, 0.73, 0.32], atol=1e-12)
+    np.testing.assert_allclose(cavity_probe(f, 0.03, drop=0.3).spawn, [-0.75, 0.73, 0.32], atol=1e-12)
+    drawer = cavity_probe(front_of(DRAWER_OBJ), 0.03, drop=0.1)
+    np.testing.assert_allclose(drawer.spawn, [0.3, 0.29, 0.16], atol=1e-12)
+    np.testing.assert_allclose(drawer.center, [0.3, 0.29, 0.17], atol=1e-12)
+    assert fell_enough(plan.box, plan.spawn, np.array([-0.75, 0.73, 0.11]), 0.03)  # half of 0.1
+
+
 def test_probe_shrinks_for_small_fronts() -> None:
     small = DOOR_OBJ.model_copy(update={"obb": OBB(center=(0, 0, 0), axes=((0, 0, 1), (1, 0, 0), (0, 1, 0)),
                                                    extents=(0.15, 0.1, 0.02))})
