@@ -55,18 +55,9 @@ def cache_dir() -> Path:
 
 def _listing(url: str) -> dict[str, dict[str, Any]]:
     """The scan's files (hidden ones skipped, as the scene fingerprint skips them): size and ETag by path."""
-    fs, path = storage.filesystem(url)
-    path = path.rstrip("/")
-    try:
-        found = fs.find(path, detail=True)
-    except FileNotFoundError:
-        found = {}
-    files = {}
-    for name, info in found.items():
-        rel = name[len(path):].lstrip("/")
-        if info.get("type", "file") != "file" or not rel or any(p.startswith(".") for p in rel.split("/")):
-            continue
-        files[rel] = {"size": int(info.get("size", 0)), "etag": str(info.get("ETag", "")).strip('"')}
+    files = {rel: {"size": int(info.get("size", 0)), "etag": str(info.get("ETag", "")).strip('"')}
+             for rel, info in storage.find_files(url).items()
+             if rel and not any(p.startswith(".") for p in rel.split("/"))}
     if not files:
         raise InputError(url, "no scan files there (an empty or missing prefix)")
     return files

@@ -117,6 +117,19 @@ def filesystem(url: str) -> tuple[Any, str]:
 
 # --- the remote mirror of the content store ---------------------------------------------------------
 
+def find_files(url: str) -> dict[str, dict[str, Any]]:
+    """Files under ``url`` (local or remote) by path relative to it, with the store's details (size,
+    ETag, mtime); nothing when it does not exist."""
+    fs, path = filesystem(url)
+    path = path.rstrip("/")
+    try:
+        found = fs.find(path, detail=True)
+    except FileNotFoundError:
+        return {}
+    return {name[len(path):].lstrip("/"): info for name, info in found.items()
+            if info.get("type", "file") == "file" and name.startswith(path)}
+
+
 def push_file(local: Path, rel: str) -> None:
     """Upload one store file (``rel`` under the store root) unless the remote already has it, same size."""
     root = remote_root()

@@ -93,18 +93,6 @@ def _mtime(info: dict[str, Any]) -> float:
     return time.time()  # unknown age: counts as new, so it is never removed by age
 
 
-def _find(url: str) -> dict[str, dict[str, Any]]:
-    """Files under ``url`` by path relative to it (nothing when it does not exist)."""
-    fs, path = storage.filesystem(url)
-    path = path.rstrip("/")
-    try:
-        found = fs.find(path, detail=True)
-    except FileNotFoundError:
-        return {}
-    return {name[len(path):].lstrip("/"): info for name, info in found.items()
-            if info.get("type", "file") == "file" and name.startswith(path)}
-
-
 def plan_clean(older_than_days: float | None = None, grace_s: float = DEFAULT_GRACE_S,
                now: float | None = None) -> Plan:
     """What ``cache clean --store`` removes now (see the module docstring); removes nothing itself."""
@@ -117,7 +105,7 @@ def plan_clean(older_than_days: float | None = None, grace_s: float = DEFAULT_GR
     cutoff = None if older_than_days is None else now - older_than_days * 86400
 
     remove: list[Entry] = []
-    records = _find(records_at)
+    records = storage.find_files(records_at)
     live: list[str] = []
     for rel, info in sorted(records.items()):
         if cutoff is not None and RECORD_RE.match(rel) and _mtime(info) < cutoff:
@@ -126,7 +114,7 @@ def plan_clean(older_than_days: float | None = None, grace_s: float = DEFAULT_GR
             live.append(f"{rec_root}/{rel}")
     referenced = _references(fs, live)
 
-    files = {f"{top}/{rel}": info for top in ("objects", "scenes") for rel, info in _find(f"{store}/{top}").items()}
+    files = {f"{top}/{rel}": info for top in ("objects", "scenes") for rel, info in storage.find_files(f"{store}/{top}").items()}
     if rec_root.startswith(root + "/"):  # records kept inside the store are not store entries
         inner = rec_root[len(root) + 1:] + "/"
         files = {k: v for k, v in files.items() if not k.startswith(inner)}
