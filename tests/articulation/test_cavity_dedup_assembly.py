@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from benchmarks import ablation_refinement
 from react3d_core.articulation.limits import revolute_limit, set_limits
 from react3d_core.articulation.types import ArticulatedPart
 from react3d_core.assembly import carve_background
@@ -292,17 +293,6 @@ def test_sweep_glides_under_a_trim_beside_its_path() -> None:
     assert src == "blocked" and q < np.radians(2)
 
 
-def _ablation_module():  # noqa: ANN202
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).parents[2] / "benchmarks" / "ablation_refinement.py"
-    spec = importlib.util.spec_from_file_location("ablation_refinement", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
 @pytest.mark.slow
 def test_synthetic_scene_cavities_limits_no_interpenetration(synthetic_scene, tmp_path) -> None:  # noqa: ANN001
     """Oracle parts of a synthetic kitchen through assemble_scene: cavity depth within 3 cm of the true
@@ -312,12 +302,12 @@ def test_synthetic_scene_cavities_limits_no_interpenetration(synthetic_scene, tm
     from react3d_core.data.mesh import load_mesh
 
     root = synthetic_scene(seed=4, n_frames=20, kind="kitchen")
-    scene, mesh, pairs = _ablation_module().oracle_parts(root, seed=0)
+    scene, mesh, pairs = ablation_refinement.oracle_parts(root, seed=0)
     m = assemble_scene(scene, mesh, [p for p, _ in pairs], PipelineConfig(), tmp_path / "o")
     meta = json.loads((root / "synth_meta.json").read_text())
     depth_of = {p["label"]: p["interior_depth"] for p in meta["parts"] if p.get("interior_depth") is not None}
     assert len(m.objects) == len(pairs) >= 5
-    gt_label = _ablation_module().gt_labels(m.objects, [p for p, _ in pairs])
+    gt_label = ablation_refinement.gt_labels(m.objects, [p for p, _ in pairs])
     errs = np.array([abs(o.cavity_depth - depth_of[gt_label[o.object_id]]) for o in m.objects])
     assert (errs < 0.03).mean() >= 0.9, errs
     for o in m.objects:
@@ -332,7 +322,7 @@ def test_synthetic_scene_cavities_limits_no_interpenetration(synthetic_scene, tm
 @pytest.mark.slow
 def test_refinement_ablation_on_five_synthetic_scenes(synthetic_scene) -> None:  # noqa: ANN001
     """OPDMulti-like noise (7 deg, 0.2 m): refinement brings mean OE <= 1.5 deg and mean MD <= 0.05 m."""
-    mod = _ablation_module()
+    mod = ablation_refinement
     rows = [r for s in range(5) for r in mod.ablate_scene(synthetic_scene(seed=s, n_frames=12), seed=s)]
     res = mod.summarize(rows)
     assert res["parts"] >= 25

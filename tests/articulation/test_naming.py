@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import importlib.util
 from pathlib import Path
 
 import numpy as np
 import pytest
 import trimesh
 
+from benchmarks import ablation_refinement
 from react3d_core.assembly.naming import appliance_tag, floor_height, object_ids, part_label
 from react3d_core.config.assembly import AssemblyConfig
 from react3d_core.data import Articulation, TriMesh
@@ -86,21 +86,13 @@ def test_ids_are_numbered_per_label_in_spatial_order() -> None:
     assert many[0] == "flap_001" and many[-1] == "flap_120" and len(set(many)) == 120
 
 
-def _ablation_module():  # noqa: ANN202
-    path = Path(__file__).parents[2] / "benchmarks" / "ablation_refinement.py"
-    spec = importlib.util.spec_from_file_location("ablation_refinement", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
-
-
 def test_names_are_stable_across_runs(synthetic_scene, tmp_path: Path) -> None:  # noqa: ANN001
     """Two assemblies of the same parts, found in opposite orders: the same names for the same parts."""
     from react3d_core.assembly import assemble_scene
     from react3d_core.config import PipelineConfig
 
     root = synthetic_scene(seed=3, n_frames=16, kind="dresser")
-    scene, mesh, pairs = _ablation_module().oracle_parts(root, seed=0)
+    scene, mesh, pairs = ablation_refinement.oracle_parts(root, seed=0)
     parts = [p for p, _ in pairs]
     runs = []
     for k, order in enumerate((parts, parts[::-1])):
