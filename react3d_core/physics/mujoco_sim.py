@@ -67,6 +67,7 @@ class MujocoSim(Sim):
         self.link_parent = {self.body_names[b]: (self.body_names[int(m.body_parentid[b])] if m.body_weldid[int(m.body_parentid[b])] != 0
                                                  else None) for b in range(m.nbody) if self.body_names[b] in self.moving}
         self.contype0, self.conaffinity0 = m.geom_contype.copy(), m.geom_conaffinity.copy()
+        self.body_contype0, self.body_conaffinity0 = m.body_contype.copy(), m.body_conaffinity.copy()
         self.kp = self.kd = np.zeros(len(self.joints))
         self.fmax = np.inf
 
@@ -131,13 +132,17 @@ class MujocoSim(Sim):
         return out
 
     def collide_only(self, links: frozenset[str] | None) -> None:
+        """The bits of the geoms and of their bodies (the broad phase reads the bodies' OR of their geoms'
+        bits, which ``mj_setConst`` recomputes from the geoms as they are)."""
         m = self.m
         m.geom_contype[:], m.geom_conaffinity[:] = self.contype0, self.conaffinity0
+        m.body_contype[:], m.body_conaffinity[:] = self.body_contype0, self.body_conaffinity0
         if links is None:
             return
         off = [self.body_id[n] for n in self.moving - links]
         g = np.isin(m.geom_bodyid, off)
         m.geom_contype[g], m.geom_conaffinity[g] = 0, 0
+        m.body_contype[off], m.body_conaffinity[off] = 0, 0
 
     def add_probe(self, pos: np.ndarray, vel: np.ndarray, radius: float, mass: float, gravity: bool) -> None:
         m, d, mj = self.m, self.d, self.mj

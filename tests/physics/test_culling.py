@@ -106,3 +106,19 @@ def test_a_joint_past_its_assumed_range_runs_again_in_full(blocker_out: Path) ->
     reruns = culled.settings["contact_culling"]["reruns"]
     assert any(r.startswith("drive door_joint: left its assumed range") for r in reruns), reruns
     assert [j.model_dump() for j in culled.joints] == [j.model_dump() for j in full.joints]
+
+
+def test_mujoco_comes_back_whole_after_a_probe_resized_while_culled(blocker_out: Path) -> None:
+    # resizing the probe recomputes MuJoCo's per-body collision bits from the geoms as they are (mj_setConst):
+    # taking every link back in must restore the bodies' bits too, or a link stays out of contacts for good
+    pytest.importorskip("mujoco")
+    root, scene = load_output(blocker_out)
+    sim = _make("mujoco", root / scene.exports["mjcf"], PhysicsConfig())
+    m = sim.m
+    body0, geom0 = m.body_contype.copy(), m.geom_contype.copy()
+    sim.reset(np.zeros(len(sim.joints)))
+    sim.collide_only(frozenset({"door"}))
+    assert m.body_contype[sim.body_id["drawer"]] == 0 and m.body_contype[sim.body_id["door"]] != 0
+    sim.add_probe(np.array([0.3, 0.3, 0.5]), np.zeros(3), 0.011, 0.1, gravity=False)  # a new radius: mj_setConst
+    sim.collide_only(None)
+    assert (m.body_contype == body0).all() and (m.geom_contype == geom0).all()
