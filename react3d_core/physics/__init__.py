@@ -8,7 +8,6 @@ used, and a missing one is skipped with the reason. Definitions: docs/physics.md
 """
 
 from ..stage import StageSpec
-from . import reach
 from .check import DEFAULT_JSON, check_output, load_output, write_check
 from .result import EngineCheck, JointCheck, PhysicsCheck, ProbeCheck, RestCheck, Touch
 
