@@ -45,6 +45,14 @@ class PhysicsConfig(StageConfig):
     cavity_drop_m: float = Field(0.1, gt=0, description="The cavity probe falls from at most this height above the cavity's floor (m), as an object is put "
                                                        "into a cupboard (the cavity's centre is still checked for clearance): dropped from a tall "
                                                        "cavity's centre, a small probe hits at 2-3 m/s and MuJoCo's soft contact lets it sink through a 1.5 cm board.")
+    cull_contacts: bool = Field(
+        True, description="While one joint is driven or one probe flies, links held at 0 that neither can come near (further than "
+                          "cull_margin_m from the box swept by the driven part, or from the probe's path) sit out of contacts; an "
+                          "episode that leaves what was assumed (the joint past its range by more than cull_overshoot, the probe "
+                          "out of its path, a held link touched) is run again with every collider on. Same results, a fraction of "
+                          "the narrow phase in a large scene (MuJoCo, SAPIEN).")
+    cull_margin_m: float = Field(0.05, gt=0, description="Links within this distance (m) of an episode's region keep their contacts (cull_contacts).")
+    cull_overshoot: float = Field(0.1, ge=0, description="A driven joint is assumed to stay within 0..goal widened by this fraction of the range at each end (cull_contacts).")
     front_probe_s: float = Field(0.4, gt=0, description="Time the front probe flies and bounces (s); longer for a deep front, so that an unhindered probe ends 5 cm past its back face.")
 
     @field_validator("engines")

@@ -72,13 +72,15 @@ def run_engine(sim: Sim, targets: list[Front], cfg: PhysicsConfig, progress: Pro
     sim.set_gains(kp, kd, cfg.max_force)
     say(sim.engine, "rest")
     rest, problems = drive.rest(sim, cfg)
+    cull = drive.culling(sim, cfg)
     order = sorted(range(len(sim.joints)), key=lambda i: sim.joints[i].name)
     joints = []
     for i in order:
         j = sim.joints[i]
         say(sim.engine, f"drive {j.name}")
         f = matched.get(j.name)
-        joints.append(drive.drive(sim, i, cfg, f.object_id if f else None, rest.drift.get(j.name, 0.0), problems.get(j.name)))
+        joints.append(drive.drive(sim, i, cfg, f.object_id if f else None, rest.drift.get(j.name, 0.0), problems.get(j.name),
+                                  cull))
     probes = []
     if cfg.probes:
         for i in order:
@@ -86,11 +88,13 @@ def run_engine(sim: Sim, targets: list[Front], cfg: PhysicsConfig, progress: Pro
             if f is None:
                 continue
             say(sim.engine, f"front probe {f.object_id}")
-            probes.append(drive.front(sim, i, f, cfg))
+            probes.append(drive.front(sim, i, f, cfg, cull))
             if f.cavity_depth:
                 say(sim.engine, f"cavity probe {f.object_id}")
-                probes.append(drive.cavity(sim, i, f, cfg))
+                probes.append(drive.cavity(sim, i, f, cfg, cull))
     unmatched = sorted({f.object_id for f in targets} - {f.object_id for f in matched.values()})
+    if cull is not None:
+        sim.settings["contact_culling"] = cull.settings()
     return {"rest": rest}, joints, probes, unmatched
 
 

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..config.physics import PhysicsConfig
+from . import reach
 from .result import JointCheck, Pair, ProbeCheck, RestCheck, Touch
 from .sim import PROBE, Contact, Sim, SimJoint
 from .targets import Front, advance, cavity_box, cavity_probe, fell_enough, front_probe
@@ -118,6 +119,72 @@ def _every(cfg: PhysicsConfig, dt: float) -> int:
     return max(1, int(round(1.0 / (cfg.contact_hz * dt))))
 
 
+@dataclass
+class Culling:
+    """Contacts of each episode limited to the links it can reach (``reach.py``): the moving links' boxes
+    at q = 0, what each joint carries, and how many episodes ran culled or had to be run again in full."""
+
+    boxes: dict[str, np.ndarray]
+    carried: list[frozenset[str]]
+    moving: frozenset[str]
+    margin: float
+    overshoot: float
+    culled: int = 0
+    rerun: int = 0
+    reruns: list[str] = field(default_factory=list)
+
+    def swept(self, sim: Sim, i: int, q0: float, q1: float) -> np.ndarray | None:
+        """Box swept by what joint ``i`` carries from ``q0`` to ``q1`` (None: it carries no collider)."""
+        j = sim.joints[i]
+        return reach.merge(reach.swept(self.boxes[n], j, q0, q1) for n in self.carried[i] if n in self.boxes)
+
+    def links(self, i: int, region: np.ndarray | None) -> frozenset[str]:
+        """What joint ``i`` carries and every moving link within ``margin`` of ``region``."""
+        if region is None:
+            return self.carried[i]
+        return reach.needed(self.boxes, region, self.margin, self.carried[i])
+
+    def neighbours_touched(self, i: int, touched: list[Touch]) -> list[str]:
+        """Moving links, other than what joint ``i`` carries, among ``touched``: a held link that was
+        touched may be pushed into one that sat out."""
+        return [t.body for t in touched if t.body in self.moving and t.body not in self.carried[i]]
+
+    def settings(self) -> dict:
+        return {"margin_m": self.margin, "overshoot": self.overshoot, "episodes_culled": self.culled,
+                "episodes_rerun_in_full": self.rerun, "reruns": self.reruns}
+
+
+def culling(sim: Sim, cfg: PhysicsConfig) -> Culling | None:
+    """The culling of ``sim`` (None when switched off or when the engine cannot do it)."""
+    if not cfg.cull_contacts:
+        return None
+    sim.reset(np.zeros(len(sim.joints)))
+    boxes = sim.link_boxes()
+    if not boxes:
+        return None
+    return Culling(boxes, [sim.carried(i) for i in range(len(sim.joints))], sim.moving, cfg.cull_margin_m, cfg.cull_overshoot)
+
+
+def _culled(sim: Sim, cull: Culling | None, links: frozenset[str] | None, run: Callable[[], tuple],
+            fine: Callable[[tuple], str | None], what: str) -> tuple:
+    """``run()`` with only ``links`` colliding; run again with every collider on when ``fine(result)``
+    names something the culled run did not assume."""
+    if cull is None or links is None:
+        return run()
+    sim.collide_only(links)
+    try:
+        out = run()
+    finally:
+        sim.collide_only(None)
+    why = fine(out)
+    if why is None:
+        cull.culled += 1
+        return out
+    cull.rerun += 1
+    cull.reruns.append(f"{what}: {why}")
+    return run()
+
+
 def rest(sim: Sim, cfg: PhysicsConfig) -> tuple[RestCheck, dict[str, str]]:
     """Every joint held at 0 for ``rest_s``: contacts after the first step, the largest |q| of each joint.
     Returns the result and, per joint, a drift or instability found here."""
@@ -161,8 +228,30 @@ def rest(sim: Sim, cfg: PhysicsConfig) -> tuple[RestCheck, dict[str, str]]:
 
 
 def drive(sim: Sim, i: int, cfg: PhysicsConfig, object_id: str | None, rest_drift: float,
-          rest_problem: str | None) -> JointCheck:
-    """Joint ``i`` driven alone to its goal and back (module doc); the others held at 0."""
+          rest_problem: str | None, cull: Culling | None = None) -> JointCheck:
+    """Joint ``i`` driven alone to its goal and back (module doc); the others held at 0. With ``cull``,
+    only links within reach of what the joint carries collide (run again in full when the joint left its
+    assumed range or touched a held link)."""
+    goal = goal_of(sim.joints[i])
+    links = lo = hi = None
+    if cull is not None and np.isfinite(goal) and goal != 0:
+        lo, hi = reach.motion_range(goal, cull.overshoot)
+        links = cull.links(i, cull.swept(sim, i, lo, hi))
+
+    def fine(out: tuple) -> str | None:
+        res, qmin, qmax = out
+        if not (lo <= qmin and qmax <= hi):
+            return f"left its assumed range ({qmin:.3f}..{qmax:.3f} outside {lo:.3f}..{hi:.3f})"
+        held = cull.neighbours_touched(i, res.touched)
+        return f"touched held {', '.join(held)}" if held else None
+
+    return _culled(sim, cull, links, lambda: _drive(sim, i, cfg, object_id, rest_drift, rest_problem), fine,
+                   f"drive {sim.joints[i].name}")[0]
+
+
+def _drive(sim: Sim, i: int, cfg: PhysicsConfig, object_id: str | None, rest_drift: float,
+           rest_problem: str | None) -> tuple[JointCheck, float, float]:
+    """The episode of :func:`drive`; also the smallest and largest value the joint took."""
     j = sim.joints[i]
     n = len(sim.joints)
     goal = goal_of(j)
@@ -170,7 +259,7 @@ def drive(sim: Sim, i: int, cfg: PhysicsConfig, object_id: str | None, rest_drif
                 rest_drift=rest_drift)
     if not np.isfinite(goal) or goal == 0:
         return JointCheck(**base, reached=0.0, returned=0.0, penetration=0.0, passed=False,
-                          causes=["no finite non-zero limit to drive to"])
+                          causes=["no finite non-zero limit to drive to"]), 0.0, 0.0
     T, hold = move_time(j, cfg), cfg.hold_s
     vmax = speed_limits(sim.joints, cfg)
     sim.reset(np.zeros(n))
@@ -179,6 +268,7 @@ def drive(sim: Sim, i: int, cfg: PhysicsConfig, object_id: str | None, rest_drif
     qt, vt = np.zeros(n), np.zeros(n)
     reached, t_reach, top_speed, unstable = 0.0, None, 0.0, None
     q = np.zeros(n)
+    qmin = qmax = 0.0
     for k in range(_steps(2 * T + 2 * hold, sim.dt)):
         t = (k + 1) * sim.dt
         qt[i], vt[i] = target(t, goal, T, hold)
@@ -186,6 +276,8 @@ def drive(sim: Sim, i: int, cfg: PhysicsConfig, object_id: str | None, rest_drif
         if k % every == 0:
             log.add(sim.contacts(log.watch))
         q, qd = sim.state()
+        qi = float(q[i])
+        qmin, qmax = (min(qmin, qi), max(qmax, qi)) if math.isfinite(qi) else (-math.inf, math.inf)
         unstable = instability(q, qd, vmax, sim.joints, t, watch=[i])
         if unstable:
             break
@@ -210,11 +302,46 @@ def drive(sim: Sim, i: int, cfg: PhysicsConfig, object_id: str | None, rest_drif
     if unstable:
         causes.append(unstable)
     return JointCheck(**base, reached=reached, time_to_reach=t_reach, returned=returned, penetration=log.deepest,
-                      touched=touched, max_speed=top_speed, unstable=unstable, passed=not causes, causes=causes)
+                      touched=touched, max_speed=top_speed, unstable=unstable, passed=not causes, causes=causes), qmin, qmax
+
+
+@dataclass
+class ProbePath:
+    """The box the probe's centre went through (non-finite: lost)."""
+
+    lo: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    hi: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
+    finite: bool = True
+
+    def add(self, p: np.ndarray) -> None:
+        if not np.all(np.isfinite(p)):
+            self.finite = False
+            return
+        self.lo, self.hi = np.minimum(self.lo, p), np.maximum(self.hi, p)
+
+    def within(self, box: np.ndarray) -> bool:
+        return self.finite and bool(np.all(self.lo >= box[0]) and np.all(self.hi <= box[1]))
+
+
+def _probe_region(points: list[np.ndarray], radius: float) -> np.ndarray:
+    """Box of the probe's planned centres, grown by its radius."""
+    return reach.grow(np.array([np.min(points, axis=0), np.max(points, axis=0)]), radius)
+
+
+def _probe_fine(cull: Culling, i: int, centres: np.ndarray, radius: float) -> Callable[[tuple], str | None]:
+    """Rerun in full when the probe's centre left its planned box (widened by half the margin) or touched
+    a held link."""
+    def fine(out: tuple) -> str | None:
+        res, path = out[0], out[-1]
+        if not path.within(reach.grow(centres, cull.margin / 2)):
+            return "the probe left its planned path"
+        held = cull.neighbours_touched(i, res.touched)
+        return f"the probe touched held {', '.join(held)}" if held else None
+    return fine
 
 
 def _probe_loop(sim: Sim, q_hold: np.ndarray, seconds: float, cfg: PhysicsConfig,
-                track: Callable[[np.ndarray], None] | None = None) -> tuple[ContactLog, float]:
+                track: Callable[[np.ndarray], None] | None = None, path: ProbePath | None = None) -> tuple[ContactLog, float]:
     """Step with the joints held at ``q_hold``; returns the probe's contacts and how deep it was right
     after being placed (first step)."""
     log = ContactLog(frozenset({PROBE}))
@@ -226,12 +353,51 @@ def _probe_loop(sim: Sim, q_hold: np.ndarray, seconds: float, cfg: PhysicsConfig
         if k == 0:
             spawn = max((max(0.0, -c.dist) for c in cs), default=0.0)
         log.add(cs)
-        if track is not None:
-            track(sim.probe()[0])
+        if track is not None or path is not None:
+            p = sim.probe()[0]
+            if track is not None:
+                track(p)
+            if path is not None:
+                path.add(p)
     return log, spawn
 
 
-def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
+def _joint_region(sim: Sim, i: int, cull: Culling) -> tuple[np.ndarray | None, float, float]:
+    goal = goal_of(sim.joints[i])
+    lo, hi = reach.motion_range(goal, cull.overshoot)
+    return cull.swept(sim, i, lo, hi), lo, hi
+
+
+def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig, cull: Culling | None = None) -> ProbeCheck:
+    """:func:`_cavity`; with ``cull``, only links within reach of the joint's swept box and of the probe's
+    planned path collide (run again in full when the probe left that path, the joint its range, or the
+    probe touched a held link)."""
+    links = centres = None
+    lo = hi = 0.0
+    if cull is not None:
+        region, lo, hi = _joint_region(sim, i, cull)
+        plan = cavity_probe(f, cfg.probe_radius_m, drop=cfg.cavity_drop_m)
+        pts = [plan.center, plan.spawn, *plan.box.corners()]
+        if f.moving_cavity:
+            pts += [c for q in np.linspace(lo, hi, 9) for c in cavity_box(f).moved(f.articulation, float(q)).corners()]
+        centres = _probe_region(pts, 0.0)
+        probe = reach.grow(centres, plan.radius)
+        links = cull.links(i, probe if region is None else reach.merge([region, probe]))
+        inner = _probe_fine(cull, i, centres, plan.radius)
+
+        def fine(out: tuple) -> str | None:
+            qmin, qmax = out[1]
+            if not (lo <= qmin and qmax <= hi):
+                return f"the joint left its assumed range ({qmin:.3f}..{qmax:.3f} outside {lo:.3f}..{hi:.3f})"
+            return inner(out)
+    else:
+        def fine(out: tuple) -> str | None:
+            return None
+
+    return _culled(sim, cull, links, lambda: _cavity(sim, i, f, cfg), fine, f"cavity probe {f.object_id}")[0]
+
+
+def _cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> tuple[ProbeCheck, tuple[float, float], ProbePath]:
     """The joint held at its goal; a sphere placed at the cavity's centre for one step (held there), then
     dropped from straight below it, at most ``cavity_drop_m`` above the floor. Free: placed clear of every
     collider both times (<= 1 mm), ends inside the cavity (moved with the joint's final value for a
@@ -243,12 +409,18 @@ def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
     plan = cavity_probe(f, cfg.probe_radius_m, drop=cfg.cavity_drop_m)
     q = np.zeros(len(sim.joints))
     q[i] = goal
+    path = ProbePath()
+    qs = [float(goal)]
+
+    def joint(_: np.ndarray) -> None:
+        qs.append(float(sim.state()[0][i]))
+
     sim.reset(q)
     sim.add_probe(plan.center, np.zeros(3), plan.radius, cfg.probe_mass_kg, gravity=False)
-    at_center, spawn_c = _probe_loop(sim, q, sim.dt, cfg)
+    at_center, spawn_c = _probe_loop(sim, q, sim.dt, cfg, joint, path)
     sim.reset(q)
     sim.add_probe(plan.spawn, np.zeros(3), plan.radius, cfg.probe_mass_kg, gravity=True)
-    log, spawn = _probe_loop(sim, q, cfg.cavity_probe_s, cfg)
+    log, spawn = _probe_loop(sim, q, cfg.cavity_probe_s, cfg, joint, path)
     if spawn_c > spawn:
         spawn, log = spawn_c, at_center
     end = sim.probe()[0]
@@ -270,12 +442,34 @@ def cavity(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
         cause = "pushed out of the cavity" + (f" (touching {', '.join(t.body for t in touched[:3])})" if touched else "")
     elif not fell:
         cause = "held up inside the cavity" + (f" by {', '.join(t.body for t in touched[:3])}" if touched else "")
+    qr = np.asarray(qs)
+    span = (float(qr.min()), float(qr.max())) if np.all(np.isfinite(qr)) else (-math.inf, math.inf)
     return ProbeCheck(kind="cavity", object_id=f.object_id, joint=j.name, radius=plan.radius, start=tuple(plan.spawn),
                       end=tuple(float(x) for x in end), spawn_depth=spawn, penetration=log.deepest, touched=touched,
-                      passed=cause is None, cause=cause)
+                      passed=cause is None, cause=cause), span, path
 
 
-def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
+def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig, cull: Culling | None = None) -> ProbeCheck:
+    """:func:`_front`; with ``cull``, only what the joint carries and links within reach of the probe's
+    planned path (its straight flight, forward and back) collide (run again in full when the probe left
+    that path or touched a held link)."""
+    links = None
+    fine: Callable[[tuple], str | None] = lambda out: None  # noqa: E731
+    if cull is not None:
+        plan = front_probe(f, cfg.probe_radius_m, cfg.probe_speed)
+        seconds = _front_seconds(f, plan, cfg)
+        centres = _probe_region([plan.start - plan.velocity * seconds, plan.start + plan.velocity * seconds], 0.0)
+        links = cull.links(i, reach.grow(centres, plan.radius))
+        fine = _probe_fine(cull, i, centres, plan.radius)
+    return _culled(sim, cull, links, lambda: _front(sim, i, f, cfg), fine, f"front probe {f.object_id}")[0]
+
+
+def _front_seconds(f: Front, plan, cfg: PhysicsConfig) -> float:  # noqa: ANN001 - a FrontProbe
+    """Long enough for an unhindered probe to end 5 cm past the back face, whatever the front's depth."""
+    return max(cfg.front_probe_s, (float(np.dot(f.back - plan.start, f.n)) + 0.05) / cfg.probe_speed + 0.1)
+
+
+def _front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> tuple[ProbeCheck, ProbePath]:
     """Every joint held at 0; a sphere (gravity compensated) pushed at the front's centre, for ``front_probe_s``
     or longer when the front is deep (an unhindered probe ends 5 cm past its back face). Blocked: placed
     clear of every collider, the first body it touches is the front's link, and its leading point never
@@ -290,9 +484,8 @@ def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
     def track(p: np.ndarray) -> None:
         deepest[0] = max(deepest[0], advance(f, p, plan.radius))
 
-    # long enough for an unhindered probe to end 5 cm past the back face, whatever the front's depth
-    seconds = max(cfg.front_probe_s, (float(np.dot(f.back - plan.start, f.n)) + 0.05) / cfg.probe_speed + 0.1)
-    log, spawn = _probe_loop(sim, q, seconds, cfg, track)
+    path = ProbePath()
+    log, spawn = _probe_loop(sim, q, _front_seconds(f, plan, cfg), cfg, track, path)
     end = sim.probe()[0]
     adv = float(deepest[0]) if np.isfinite(deepest[0]) else None  # None: the probe's state was not finite
     touched = log.touches(by_depth=False)
@@ -310,4 +503,4 @@ def front(sim: Sim, i: int, f: Front, cfg: PhysicsConfig) -> ProbeCheck:
         cause = f"hit {touched[0].body} before the front"
     return ProbeCheck(kind="front", object_id=f.object_id, joint=j.name, radius=plan.radius, start=tuple(plan.start),
                       end=tuple(float(x) for x in end), spawn_depth=spawn, penetration=log.deepest, advance=adv,
-                      touched=touched, passed=cause is None, cause=cause)
+                      touched=touched, passed=cause is None, cause=cause), path

@@ -64,6 +64,10 @@ class MujocoSim(Sim):
             self.joints.append(SimJoint(m.joint(j).name, kind, anchor, axis, self.body_names[b], float(lo), float(hi),
                                         effective_inertia(kind, axis, anchor, float(m.body_mass[b]), d.xipos[b], inertia)))
         self.moving = frozenset(self.body_names[b] for b in range(m.nbody) if m.body_weldid[b] != 0 and b != self.pbody)
+        self.link_parent = {self.body_names[b]: (self.body_names[int(m.body_parentid[b])] if m.body_weldid[int(m.body_parentid[b])] != 0
+                                                 else None) for b in range(m.nbody) if self.body_names[b] in self.moving}
+        self.contype0, self.conaffinity0 = m.geom_contype.copy(), m.geom_conaffinity.copy()
+        self.body_contype0, self.body_conaffinity0 = m.body_contype.copy(), m.body_conaffinity.copy()
         self.kp = self.kd = np.zeros(len(self.joints))
         self.fmax = np.inf
 
@@ -111,6 +115,34 @@ class MujocoSim(Sim):
         bn, gn = self.body_names, self.geom_names
         return [Contact(bn[b0], bn[b1], float(dist[k]), gn[g0], gn[g1])
                 for k, (b0, b1), (g0, g1) in zip(keep, b, g)]
+
+    def link_boxes(self) -> dict[str, np.ndarray]:
+        m, d = self.m, self.d
+        out: dict[str, np.ndarray] = {}
+        g = np.flatnonzero((self.contype0 | self.conaffinity0) != 0)
+        for k in g:
+            name = self.body_names[int(m.geom_bodyid[k])]
+            if name not in self.moving:
+                continue
+            R = d.geom_xmat[k].reshape(3, 3)
+            c = d.geom_xpos[k] + R @ m.geom_aabb[k, :3]  # the geom's box: centre offset and half sizes in its frame
+            h = np.abs(R) @ m.geom_aabb[k, 3:]
+            box = np.array([c - h, c + h])
+            out[name] = box if name not in out else np.array([np.minimum(out[name][0], box[0]), np.maximum(out[name][1], box[1])])
+        return out
+
+    def collide_only(self, links: frozenset[str] | None) -> None:
+        """The bits of the geoms and of their bodies (the broad phase reads the bodies' OR of their geoms'
+        bits, which ``mj_setConst`` recomputes from the geoms as they are)."""
+        m = self.m
+        m.geom_contype[:], m.geom_conaffinity[:] = self.contype0, self.conaffinity0
+        m.body_contype[:], m.body_conaffinity[:] = self.body_contype0, self.body_conaffinity0
+        if links is None:
+            return
+        off = [self.body_id[n] for n in self.moving - links]
+        g = np.isin(m.geom_bodyid, off)
+        m.geom_contype[g], m.geom_conaffinity[g] = 0, 0
+        m.body_contype[off], m.body_conaffinity[off] = 0, 0
 
     def add_probe(self, pos: np.ndarray, vel: np.ndarray, radius: float, mass: float, gravity: bool) -> None:
         m, d, mj = self.m, self.d, self.mj

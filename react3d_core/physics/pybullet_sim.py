@@ -17,6 +17,8 @@ import numpy as np
 from .sim import PROBE, TOUCH, Contact, Sim, SimJoint, effective_inertia
 
 G = 9.81
+DEFAULT_GROUP, ALL_GROUPS = 1, -1
+"""Bullet's broad-phase filter of a link with mass (btBroadphaseProxy DefaultFilter, AllFilter)."""
 
 
 class PybulletSim(Sim):
@@ -85,6 +87,11 @@ class PybulletSim(Sim):
         for k, a in enumerate(still):
             for b in still[k + 1:]:
                 pb.setCollisionFilterPair(body, body, a, b, 0, physicsClientId=cid)
+        self.link_index = {self.link_names[i]: i for i in range(n)}
+        self.link_parent = {self.link_names[i]: (self.link_names[parent[i]] if parent[i] >= 0 and self.link_names[parent[i]] in self.moving
+                                                 else None) for i in range(n) if self.link_names[i] in self.moving}
+        self.solid = frozenset(nm for nm in self.moving if pb.getCollisionShapeData(body, self.link_index[nm], physicsClientId=cid))
+        self.left_out: frozenset[str] = frozenset()
         self.kp = self.kd = np.zeros(len(self.idx))
         self.fmax = np.inf
         self.probe_id: int | None = None
@@ -127,6 +134,20 @@ class PybulletSim(Sim):
             out += [Contact(PROBE, names.get(c[4], "?"), float(c[8]))
                     for c in pb.getContactPoints(bodyA=self.probe_id, physicsClientId=cid) if c[8] <= TOUCH]
         return out
+
+    def link_boxes(self) -> dict[str, np.ndarray]:
+        pb, cid = self.pb, self.cid
+        return {nm: np.asarray(pb.getAABB(self.body, self.link_index[nm], physicsClientId=cid), float) for nm in self.solid}
+
+    def collide_only(self, links: frozenset[str] | None) -> None:
+        """A link left out gets collision filter group and mask 0 (it passes no broad phase); back in, the
+        group and mask Bullet gives a link with mass (default group, every group)."""
+        out = frozenset() if links is None else self.solid - links
+        for nm in self.left_out - out:
+            self.pb.setCollisionFilterGroupMask(self.body, self.link_index[nm], DEFAULT_GROUP, ALL_GROUPS, physicsClientId=self.cid)
+        for nm in out - self.left_out:
+            self.pb.setCollisionFilterGroupMask(self.body, self.link_index[nm], 0, 0, physicsClientId=self.cid)
+        self.left_out = out
 
     def add_probe(self, pos: np.ndarray, vel: np.ndarray, radius: float, mass: float, gravity: bool) -> None:
         pb, cid = self.pb, self.cid

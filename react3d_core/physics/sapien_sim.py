@@ -16,6 +16,9 @@ import numpy as np
 
 from .sim import PROBE, TOUCH, Contact, Sim, SimJoint, effective_inertia
 
+STILL_BIT = 1 << 31
+"""Ignore-group bit (collision group 2) that links that never move share during an episode."""
+
 ACTIVE = {"revolute": "revolute", "revolute_unwrapped": "revolute", "prismatic": "prismatic"}
 
 
@@ -86,6 +89,10 @@ class SapienSim(Sim):
             return False
 
         self.moving = frozenset(link.name for a in arts for link in a.links if moves(link))
+        self.links = {link.name: link for a in arts for link in a.links}
+        self.link_parent = {n: (link.parent.name if link.parent is not None and link.parent.name in self.moving else None)
+                            for n, link in self.links.items() if n in self.moving}
+        self.groups0 = {n: [list(sh.get_collision_groups()) for sh in link.collision_shapes] for n, link in self.links.items()}
         self.probe_entity = None
         self.probe_body = None
 
@@ -128,6 +135,24 @@ class SapienSim(Sim):
                 if p.separation <= TOUCH:
                     out.append(Contact(a, b, float(p.separation)))
         return out
+
+    def link_boxes(self) -> dict[str, np.ndarray]:
+        return {n: np.asarray(self.links[n].compute_global_aabb_tight(), float) for n in self.moving
+                if self.links[n].collision_shapes}
+
+    def collide_only(self, links: frozenset[str] | None) -> None:
+        """Also, outside ``None``, links that never move skip each other (the ignore group of PhysX's filter:
+        their contacts cannot move anything, and an episode reads only the driven link's or the probe's)."""
+        for n, link in self.links.items():
+            for sh, g in zip(link.collision_shapes, self.groups0[n]):
+                if links is None:
+                    new = g
+                elif n in self.moving:
+                    new = g if n in links else [0, 0, 0, 0]
+                else:
+                    new = [g[0], g[1], g[2] | STILL_BIT, g[3]]
+                if list(sh.get_collision_groups()) != new:
+                    sh.set_collision_groups(new)
 
     def add_probe(self, pos: np.ndarray, vel: np.ndarray, radius: float, mass: float, gravity: bool) -> None:
         sapien = self.sapien

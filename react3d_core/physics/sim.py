@@ -90,5 +90,31 @@ class Sim(ABC):
     def probe(self) -> tuple[np.ndarray, np.ndarray]:
         """Position and velocity of the probe's centre."""
 
+    link_parent: dict[str, str | None] = {}
+    """Parent link of every moving link (None at the root); read by :meth:`carried`."""
+
+    def link_boxes(self) -> dict[str, np.ndarray]:  # noqa: B027 - optional
+        """World boxes (2x3: lower, upper corner) of each moving link's colliders in the current state.
+        Empty when the engine cannot take links out of contacts (:meth:`collide_only`): every episode then
+        runs with every collider on."""
+        return {}
+
+    def collide_only(self, links: frozenset[str] | None) -> None:  # noqa: B027 - optional
+        """Moving links outside ``links`` take part in no contact (the links that never move and the probe
+        keep theirs); ``None``: every collider as loaded."""
+
+    def carried(self, i: int) -> frozenset[str]:
+        """The links joint ``i`` moves: its child link and every moving link below it."""
+        top = self.joints[i].link
+        out = set()
+        for name in self.link_parent:
+            n: str | None = name
+            while n is not None:
+                if n == top:
+                    out.add(name)
+                    break
+                n = self.link_parent.get(n)
+        return frozenset(out | {top})
+
     def close(self) -> None:  # noqa: B027 - optional
         """Release the engine's resources."""

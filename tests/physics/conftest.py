@@ -23,3 +23,9 @@ def overlapping_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @pytest.fixture(scope="session")
 def frontless_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return export(tmp_path_factory.mktemp("physics") / "frontless", door_front=False)
+
+
+@pytest.fixture(scope="session")
+def blocker_out(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The clean scene with a held plate in the drawer's way (``scenes.BLOCKER``)."""
+    return export(tmp_path_factory.mktemp("physics") / "blocker", blocker=True)

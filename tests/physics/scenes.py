@@ -68,11 +68,17 @@ LEFT_IN_BACKGROUND = [((-0.9, 0.40, 0.25), (-0.8, 0.55, 0.45)), ((-0.8, 0.65, 0.
 """(lo, hi) of the blocks ``overlapping`` leaves in the background: through the closed door, in its cavity."""
 
 
-def build_scene(out: Path, door_front: bool = True) -> Path:
+BLOCKER = Articulation(joint_type="prismatic", axis=(0, 0, 1), origin=(0.3, 0.215, 0.2), lower=0.0, upper=0.1, limit_source="test")
+BLOCKER_LO, BLOCKER_HI = (0.1, 0.2, 0.1), (0.5, 0.23, 0.3)
+"""``blocker=True``: a plate on a vertical slide standing in the room 24 cm in front of the drawer's front,
+so that the drawer (0.4 m of travel) runs into it after about 0.24 m (a near neighbour held at 0)."""
+
+
+def build_scene(out: Path, door_front: bool = True, blocker: bool = False) -> Path:
     """Write the scene's manifest and meshes under ``out``; returns the manifest path.
 
     ``door_front=False`` leaves only the door's handle in its part mesh (the front plate is missing: a
-    probe thrown at the front must get through)."""
+    probe thrown at the front must get through); ``blocker=True`` adds ``BLOCKER``."""
     meshes = out / "meshes"
     bg = [box((-2.0, -2.0, -0.05), (2.0, 1.0, 0.0)), box((-2.0, 1.0, -0.05), (2.0, 1.05, 2.0))]
     save_mesh(meshes / "background.ply", mesh(bg, 120, max_edge=0.1))
@@ -97,6 +103,12 @@ def build_scene(out: Path, door_front: bool = True) -> Path:
             inner_mesh="meshes/drawer/inner.ply", cavity_depth=0.48,
         ),
     ]
+    if blocker:
+        save_mesh(meshes / "blocker" / "part.ply", mesh([box(BLOCKER_LO, BLOCKER_HI)], 220))
+        objects.append(InteractiveObject(
+            object_id="blocker", label="drawer", articulation=BLOCKER,
+            obb=OBB(center=(0.3, 0.215, 0.2), axes=ex, extents=(0.4, 0.2, 0.03)),
+            front_normal=(0, 1, 0), part_mesh="meshes/blocker/part.ply"))
     scene = InteractiveScene(scene_id="physics_room", input_mesh="meshes/background.ply",
                              background_mesh="meshes/background.ply", objects=objects)
     return scene.save(out / "scene.json")
