@@ -55,6 +55,7 @@ class MissedPlane:
     v_top: float
     res: float
     cells: np.ndarray
+    n_returns: int = 0
 
     @property
     def area(self) -> float:
@@ -120,59 +121,111 @@ def carve(views: Sequence[HoleView], lo: np.ndarray, shape: tuple[int, int, int]
     return ((missed >= cfg.min_views) & (free <= cfg.max_free)).reshape(shape)
 
 
-def fit_vertical_planes(pts: np.ndarray, normals: np.ndarray, cameras: np.ndarray, cfg: MissedSurfaceConfig,
-                        rng: np.random.Generator, need: int, tol: float) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
-    """Vertical planes through the boundary points facing a camera side (RANSAC: a point and its normal made
-    horizontal fix a plane): ``(point, normal, inlier indices)`` while a plane gathers ``cfg.min_area`` m² of voxels."""
-    vert = np.abs(normals[:, 2]) < np.sin(np.radians(cfg.max_tilt_deg))
-    todo = np.flatnonzero(vert)
-    out = []
-    cos_n = np.cos(np.radians(cfg.normal_tol_deg))
+def island_vertices(mesh: TriMesh, max_area: float) -> np.ndarray:
+    """Vertices of mesh pieces (connected through shared vertices) under ``max_area`` m²: a missed surface keeps
+    only islands of returns, while the walls and floor around it are large connected surfaces."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    f = mesh.faces
+    n = mesh.n_vertices
+    rows = np.concatenate([f[:, 0], f[:, 1]])
+    cols = np.concatenate([f[:, 1], f[:, 2]])
+    _, lab = connected_components(coo_matrix((np.ones(len(rows), np.int8), (rows, cols)), shape=(n, n)), directed=False)
+    area = np.bincount(lab[f[:, 0]], weights=mesh.face_areas, minlength=lab.max() + 1)
+    return area[lab] < max_area
+
+
+def fit_vertical_planes(pts: np.ndarray, cameras: np.ndarray, cfg: MissedSurfaceConfig, rng: np.random.Generator,
+                        need: int, tol: float) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Vertical planes through scan returns (RANSAC: two nearby returns and the vertical fix a plane; the
+    returns' own normals are no help, a few-triangle island has any), oriented towards the cameras:
+    ``(point, normal, inlier indices)`` while a plane gathers ``need`` returns within ``tol`` m. A plane
+    most cameras stand behind, or whose inliers do not spread over ``cfg.min_spread_m`` both across and
+    up, is not a surface seen and is skipped."""
+    from scipy.spatial import cKDTree
+
+    todo = np.arange(len(pts))
+    out: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    cam_c = cameras.mean(0)
     while len(todo) >= need:
-        P, N = pts[todo], normals[todo]
-        a = rng.integers(0, len(todo), cfg.ransac_iters)
-        n = N[a] * np.array([1.0, 1.0, 0.0])  # each hypothesis: a point and its own normal, made horizontal
+        P = pts[todo]
+        k = min(cfg.ransac_neighbours, len(P))
+        a = rng.integers(0, len(P), cfg.ransac_iters)
+        _, nb_idx = cKDTree(P).query(P[a], k=k)
+        b = np.asarray(nb_idx).reshape(len(a), -1)[np.arange(len(a)), rng.integers(0, k, len(a))]
+        d = (P[b] - P[a]) * np.array([1.0, 1.0, 0.0])
+        n = np.cross(d, _UP)
         nn = np.linalg.norm(n, axis=1)
-        good = nn > 0.5
+        good = nn > cfg.voxel_m
         if not good.any():
             break
         n = n[good] / nn[good, None]
         p0 = P[a[good]]
+        n *= np.where(np.einsum("ij,ij->i", cam_c - p0, n) < 0, -1.0, 1.0)[:, None]
         scores = np.zeros(len(n), np.int64)
-        for k in range(0, len(n), 32):  # plane batches: (32, points) at a time
-            sd = np.einsum("kij,kj->ki", P[None] - p0[k:k + 32, None], n[k:k + 32])
-            agree = N @ n[k:k + 32].T
-            scores[k:k + 32] = ((np.abs(sd) <= tol) & (agree.T >= cos_n)).sum(1)
+        for i in range(0, len(n), 32):  # plane batches: (32, points) at a time
+            sd = np.einsum("kij,kj->ki", P[None] - p0[i:i + 32, None], n[i:i + 32])
+            scores[i:i + 32] = (np.abs(sd) <= tol).sum(1)
         best = int(np.argmax(scores))
         if scores[best] < need:
             break
         nb, pb = n[best], p0[best]
-        inl = (np.abs((P - pb) @ nb) <= tol) & (N @ nb >= cos_n)
-        # refit the offset to the inliers' median (the normal stays horizontal)
-        pb = pb + nb * float(np.median((P[inl] - pb) @ nb))
-        if (np.einsum("ij,j->i", cameras - pb, nb) > 0).mean() < cfg.min_camera_share:
-            todo = todo[~inl]  # a face no camera stands in front of (the back of a volume): not a surface seen
-            continue
-        out.append((pb, nb, todo[inl]))
+        for _ in range(cfg.refits):  # refit to the inliers: the horizontal line through them (least squares)
+            inl = _one_piece(P, np.abs((P - pb) @ nb) <= tol, nb, cfg.return_reach_m)
+            q = P[inl, :2] - P[inl, :2].mean(0)
+            line = np.linalg.svd(q, full_matrices=False)[2][0]
+            n2 = np.array([-line[1], line[0], 0.0])
+            nb = n2 if n2 @ nb >= 0 else -n2
+            pb = np.array([*P[inl, :2].mean(0), P[inl, 2].mean()])
+        inl = _one_piece(P, np.abs((P - pb) @ nb) <= tol, nb, cfg.return_reach_m)
+        u = np.cross(_UP, nb)
+        span = np.percentile(np.stack([P[inl] @ u, P[inl, 2]], 1), [10, 90], axis=0)
+        if (np.einsum("ij,j->i", cameras - pb, nb) > 0).mean() >= cfg.min_camera_share and np.all(span[1] - span[0] >= cfg.min_spread_m):
+            out.append((pb, nb, todo[inl]))
         todo = todo[~inl]
     return out
 
 
-def plane_cells(pts: np.ndarray, point: np.ndarray, normal: np.ndarray, cfg: MissedSurfaceConfig) -> MissedPlane | None:
-    """The plane's missed region rasterised at ``cfg.res_m``: voxel footprints splatted, gaps up to
-    ``cfg.close_m`` closed, holes filled, pieces under ``cfg.min_area`` dropped (None: nothing left)."""
+def _one_piece(P: np.ndarray, inl: np.ndarray, normal: np.ndarray, gap: float) -> np.ndarray:
+    """The inliers of a plane that form its largest piece, returns no more than ``gap`` m apart along it (a
+    plane runs on through the room and picks up returns of other surfaces it crosses)."""
+    idx = np.flatnonzero(inl)
+    if len(idx) < 2:
+        return inl
+    u = np.cross(_UP, normal)
+    uv = np.stack([P[idx] @ u, P[idx, 2]], 1)
+    cell = max(gap / 2, 1e-3)
+    g = np.floor((uv - uv.min(0)) / cell).astype(int)
+    grid = np.zeros(g.max(0) + 1, bool)
+    grid[g[:, 0], g[:, 1]] = True
+    lab, n = ndimage.label(ndimage.binary_dilation(grid, iterations=1), structure=np.ones((3, 3)))
+    if n <= 1:
+        return inl
+    pl = lab[g[:, 0], g[:, 1]]
+    out = np.zeros_like(inl)
+    out[idx[pl == np.bincount(pl).argmax()]] = True
+    return out
+
+
+def plane_cells(pts: np.ndarray, point: np.ndarray, normal: np.ndarray, cfg: MissedSurfaceConfig,
+                splat: float | None = None) -> MissedPlane | None:
+    """The plane's missed region rasterised at ``cfg.res_m``: footprints of ``splat`` m (default: a voxel)
+    around ``pts`` splatted, gaps up to ``cfg.close_m`` closed, holes filled, pieces under ``cfg.min_area``
+    dropped (None: nothing left)."""
     u = np.cross(_UP, normal)
     u /= np.linalg.norm(u)
     a, z = (pts - point) @ u, pts[:, 2]
     res = cfg.res_m
-    half = cfg.voxel_m / 2
+    size = cfg.voxel_m if splat is None else splat
+    half = size / 2
     kc = max(1, int(round(cfg.close_m / res))) | 1
     pad = kc * res  # room for the closing at the region's edges
     u0, v_top = float(a.min() - half - pad), float(z.max() + half + pad)
     w = int(np.ceil((a.max() + half + pad - u0) / res)) + 1
     h = int(np.ceil((v_top - (z.min() - half - pad)) / res)) + 1
     grid = np.zeros((h, w), np.uint8)
-    k = max(1, int(round(cfg.voxel_m / res)))
+    k = max(1, int(round(size / res)))
     c = np.round((a - half - u0) / res).astype(int)
     r = np.round((v_top - z - half) / res).astype(int)
     for dy in range(k):  # each voxel covers k x k cells
@@ -280,12 +333,13 @@ def missed_planes(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, cf
     vi = np.floor((mesh.vertices - lo) / cfg.voxel_m).astype(int)
     ok = np.all((vi >= 0) & (vi < np.array(shape)), axis=1)
     ok[ok] = vol[vi[ok, 0], vi[ok, 1], vi[ok, 2]]
-    P, N = mesh.vertices[ok], mesh.vertex_normals[ok]
+    ok &= island_vertices(mesh, cfg.max_island_m2)
+    P = mesh.vertices[ok]
     cams = np.array([-v.w2c[:3, :3].T @ v.w2c[:3, 3] for v in views])
     rng = np.random.default_rng(cfg.seed)
     centres = lo + (np.argwhere(occ) + 0.5) * cfg.voxel_m
     out = []
-    for point, normal, inl in fit_vertical_planes(P, N, cams, cfg, rng, cfg.min_returns, cfg.plane_tol_m):
+    for point, normal, inl in fit_vertical_planes(P, cams, cfg, rng, cfg.min_returns, cfg.plane_tol_m):
         on = np.abs((centres - point) @ normal) <= cfg.voxel_m  # the volume's section through the plane
         if not on.any():
             continue
@@ -294,6 +348,7 @@ def missed_planes(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, cf
             continue
         plane = near_returns(plane, P[inl], cfg)
         if plane is not None:
+            plane.n_returns = len(inl)
             out.append(plane)
     return out
 
@@ -315,14 +370,99 @@ def near_returns(plane: MissedPlane, returns: np.ndarray, cfg: MissedSurfaceConf
         return None
     if (hits.astype(bool) & cells).sum() > cfg.max_scanned * cells.sum():  # cells holding a return: what the scan has
         return None
-    return MissedPlane(plane.point, plane.normal, plane.u, plane.u0, plane.v_top, plane.res, cells)
+    return MissedPlane(plane.point, plane.normal, plane.u, plane.u0, plane.v_top, plane.res, cells, plane.n_returns)
+
+
+def merge_layers(planes: Sequence[MissedPlane], cfg: MissedSurfaceConfig) -> list[MissedPlane]:
+    """One plane per surface: of planes facing the same way (within ``cfg.merge_deg``) whose regions overlap and
+    that lie within ``cfg.merge_m`` of each other (a front's face, the handles in front of it, the worktop edge
+    above), the one with most returns is kept and takes the others' regions."""
+    order = sorted(range(len(planes)), key=lambda i: -planes[i].n_returns)
+    kept: list[MissedPlane] = []
+    cos_m = np.cos(np.radians(cfg.merge_deg))
+    for i in order:
+        p = planes[i]
+        corners = _region_points(p)
+        host = None
+        for k, q in enumerate(kept):
+            if q.normal @ p.normal < cos_m:
+                continue
+            off = (corners - q.point) @ q.normal
+            if np.abs(off).max() > cfg.merge_m:
+                continue
+            if _inside(q, corners).any():
+                host = k
+                break
+        if host is None:
+            kept.append(p)
+            continue
+        q = kept[host]
+        grown = plane_cells(np.concatenate([_region_points(q), corners]), q.point, q.normal, cfg, splat=cfg.res_m)
+        if grown is not None:
+            grown.n_returns = q.n_returns + p.n_returns
+            kept[host] = grown
+    return kept
+
+
+def _region_points(p: MissedPlane) -> np.ndarray:
+    """World centres of a plane's region cells."""
+    r, c = np.nonzero(p.cells)
+    a = p.u0 + (c + 0.5) * p.res
+    z = p.v_top - (r + 0.5) * p.res
+    return p.point + a[:, None] * p.u + (z - p.point[2])[:, None] * _UP
+
+
+def _inside(p: MissedPlane, pts: np.ndarray) -> np.ndarray:
+    """Which points fall on a region cell of ``p`` (projected along its normal)."""
+    h, w = p.cells.shape
+    c = np.floor(((pts - p.point) @ p.u - p.u0) / p.res).astype(int)
+    r = np.floor((p.v_top - pts[:, 2]) / p.res).astype(int)
+    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+    out = np.zeros(len(pts), bool)
+    out[ok] = p.cells[r[ok], c[ok]]
+    return out
+
+
+def seen_planes(planes: Sequence[MissedPlane], views: Sequence[HoleView], cfg: MissedSurfaceConfig) -> list[MissedPlane]:
+    """The planes' cells that some view sees first through a hole pixel (no depth reading, the slab in front of
+    any scan surface there), grown by ``cfg.close_m``; a slab hidden behind another (a wall behind a missed
+    cabinet) or off every hole keeps nothing. Planes left under ``cfg.min_area`` are dropped."""
+    if not planes:
+        return []
+    parts = [slab_mesh(p) for p in planes]
+    offs = np.cumsum([0] + [len(v) for v, _ in parts])
+    V = np.concatenate([v for v, _ in parts])
+    F = np.concatenate([f + o for (_, f), o in zip(parts, offs[:-1])])
+    n_faces = [len(f) for _, f in parts]
+    face_plane = np.repeat(np.arange(len(planes)), n_faces)
+    face_cell = np.concatenate([np.arange(n) % (n // 2) for n in n_faces])  # slab_mesh: two triangles per cell, in cell order
+    raster = Rasterizer(TriMesh(V, F))
+    seen = [np.zeros(p.cells.shape, np.int32) for p in planes]
+    cell_rc = [np.argwhere(p.cells) for p in planes]  # slab_mesh's cell order (row-major nonzero)
+    for v in views:
+        h, w = v.render_z.shape
+        r = raster.render(v.K, np.linalg.inv(v.w2c), w, h)
+        hole = (r.face_ids >= 0) & ((v.render_z <= 0) | (r.depth < v.render_z - cfg.margin_m))
+        if v.reading_z is not None:
+            hole &= v.reading_z <= 0
+        f = r.face_ids[hole]
+        for k in np.unique(face_plane[f]):
+            rc = cell_rc[k][face_cell[f[face_plane[f] == k]]]
+            np.add.at(seen[k], (rc[:, 0], rc[:, 1]), 1)
+    out = []
+    kc = 2 * int(round(cfg.close_m / cfg.res_m)) + 1
+    for p, sn in zip(planes, seen):
+        cells = cv2.dilate((sn > 0).astype(np.uint8), np.ones((kc, kc), np.uint8)).astype(bool) & p.cells
+        if cells.sum() * p.res ** 2 >= cfg.min_area:
+            out.append(MissedPlane(p.point, p.normal, p.u, p.u0, p.v_top, p.res, cells, p.n_returns))
+    return out
 
 
 def fill_missed_surface(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer,
                         cfg: MissedSurfaceConfig) -> tuple[TriMesh, list[MissedPlane]]:
     """``mesh`` with a coloured slab appended over every missed vertical plane (the mesh itself when none)."""
     views = hole_views(frames, raster, cfg)
-    planes = missed_planes(mesh, frames, raster, cfg, views)
+    planes = seen_planes(merge_layers(missed_planes(mesh, frames, raster, cfg, views), cfg), views, cfg)
     if not planes:
         return mesh, []
     chosen = np.unique(np.linspace(0, len(frames) - 1, min(cfg.max_views, len(frames))).round().astype(int))

@@ -10,8 +10,8 @@ import trimesh
 from react3d_core.config.scene_io import MissedSurfaceConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.raster import Rasterizer
-from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, missed_planes, plane_cells,
-                                                  slab_mesh)
+from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, island_vertices, merge_layers,
+                                                  missed_planes, plane_cells, seen_planes, slab_mesh)
 
 W, H = 160, 120
 K = np.array([[120.0, 0, 79.5], [0, 120.0, 59.5], [0, 0, 1]])
@@ -125,3 +125,40 @@ def test_plane_cells_fills_a_rectangle_of_voxels():
     assert abs(p.area - 0.6 * 0.3) < 0.02
     small = plane_cells(pts[:4], np.array([0.0, 2.0, 0.0]), np.array([0.0, -1.0, 0.0]), cfg)
     assert small is None  # under min_area
+
+
+def test_returns_are_islands_not_walls():
+    wall = _box([0, 0, 0], [2, 0.02, 2])  # 4 m² each side: one connected surface
+    chip = _box([3, 0, 0], [3.1, 0.01, 0.1])  # a 0.1 x 0.1 m patch: ~0.02 m² of surface
+    m = trimesh.util.concatenate([wall, chip])
+    isl = island_vertices(TriMesh(m.vertices, m.faces), 0.1)
+    assert not isl[:len(wall.vertices)].any() and isl[len(wall.vertices):].all()
+
+
+def _plane(y: float, x0: float, x1: float, z0: float, z1: float, n_returns: int, res: float = 0.05) -> MissedPlane:
+    w, h = int(round((x1 - x0) / res)), int(round((z1 - z0) / res))
+    return MissedPlane(point=np.array([0.0, y, 0.0]), normal=np.array([0.0, -1.0, 0.0]), u=np.array([-1.0, 0.0, 0.0]),
+                       u0=-x1, v_top=z1, res=res, cells=np.ones((h, w), bool), n_returns=n_returns)
+
+
+def test_merge_layers_keeps_the_plane_with_most_returns():
+    cfg = MissedSurfaceConfig(res_m=0.05)
+    front = _plane(1.4, 0.0, 0.8, 0.0, 0.8, n_returns=300)
+    handles = _plane(1.37, 0.1, 0.7, 0.3, 0.4, n_returns=40)  # 3 cm in front, overlapping
+    other = _plane(1.4, 2.0, 2.6, 0.0, 0.8, n_returns=50)  # same plane, elsewhere: its own surface
+    far = _plane(1.1, 0.0, 0.8, 0.0, 0.8, n_returns=60)  # 30 cm in front: another surface
+    kept = merge_layers([handles, other, front, far], cfg)
+    assert len(kept) == 3
+    assert kept[0].n_returns == 340 and np.isclose(kept[0].point[1], 1.4)
+    assert abs(kept[0].area - 0.64) < 0.05  # the handles' region lay inside the front's
+    assert {round(float(p.point[1]), 2) for p in kept[1:]} == {1.4, 1.1}
+
+
+def test_seen_planes_drops_a_slab_hidden_behind_another(corner):
+    _mesh, _r, views = corner
+    cfg = MissedSurfaceConfig()
+    front = _plane(1.4, 0.5, 1.3, 0.0, 0.8, n_returns=100, res=0.015)
+    behind = _plane(1.6, 0.8, 1.0, 0.3, 0.5, n_returns=100, res=0.015)  # inside the cabinet, hidden from every view
+    kept = seen_planes([front, behind], views, cfg)
+    assert len(kept) == 1 and np.isclose(kept[0].point[1], 1.4)
+    assert kept[0].area > 0.5
