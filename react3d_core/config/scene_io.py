@@ -11,7 +11,8 @@ class MissedSurfaceConfig(StageConfig):
     volumes; their vertical faces towards the cameras become flat coloured slabs appended to the mesh
     (react3d_core/scene_io/missed_surface.py)."""
 
-    enabled: bool = Field(False, description="Add slabs over vertical surfaces the sensor missed before any stage runs.")
+    enabled: bool = Field(True, description="Add slabs over vertical surfaces the sensor missed before any stage runs.")
+    min_hole_share: float = Field(0.08, ge=0, le=1, description="Skip the carving (a cost saver: up to a minute on a large kitchen) when the views' pixels without a depth reading are under this share on average: 0.03-0.06 on clean and TSDF held-apart scenes, whose sensors miss nothing, 0.40 on dark tuning 340.")
     voxel_m: float = Field(0.03, gt=0, description="Side of the carving voxels (m).")
     work_width: int = Field(160, ge=16, description="Width (px) of the renders and depth maps the carving reads.")
     max_views: int = Field(24, ge=1, description="At most this many views (evenly chosen) carve and colour.")

@@ -83,23 +83,34 @@ def hole_views(frames: Sequence[Frame], raster: Rasterizer, cfg: MissedSurfaceCo
     return out
 
 
+def hole_share(views: Sequence[HoleView]) -> float:
+    """Mean share of the views' pixels without a depth reading (a view without depth: without scan surface).
+    Sensors that miss dark surfaces leave many; a scan without them few (out of range, grazing, edges)."""
+    if not views:
+        return 0.0
+    return float(np.mean([((v.reading_z if v.reading_z is not None else v.render_z) <= 0).mean() for v in views]))
+
+
 def carve(views: Sequence[HoleView], lo: np.ndarray, shape: tuple[int, int, int], cfg: MissedSurfaceConfig) -> np.ndarray:
     """Voxels (grid from ``lo``, side ``cfg.voxel_m``) the sensor missed: seen through hole pixels in at least
-    ``cfg.min_views`` views and in front of a scan surface or a depth reading in at most ``cfg.max_free``."""
-    idx = np.indices(shape, dtype=np.int32).reshape(3, -1).T
-    centres = (lo + (idx + 0.5) * cfg.voxel_m).astype(np.float32)
-    missed = np.zeros(len(centres), np.int16)
-    free = np.zeros(len(centres), np.int16)
+    ``cfg.min_views`` views and in front of a scan surface or a depth reading in at most ``cfg.max_free``.
+    A voxel is dropped as soon as it is seen free too often or can no longer gather enough hole views
+    (most of a room's air after a few views), so later views project only what is left."""
+    n = int(np.prod(shape))
+    alive = np.arange(n, dtype=np.int64)
+    centres_all = (lo + (np.stack(np.unravel_index(alive, shape), 1) + 0.5) * cfg.voxel_m).astype(np.float32)
+    missed = np.zeros(n, np.int16)
+    free = np.zeros(n, np.int16)
     margin = cfg.margin_m
-    for v in views:
+    for left, v in zip(range(len(views) - 1, -1, -1), views):
+        centres = centres_all[alive] if len(alive) < n else centres_all
         h, w = v.render_z.shape
         pc = centres @ v.w2c[:3, :3].T.astype(np.float32) + v.w2c[:3, 3].astype(np.float32)
         z = pc[:, 2]
         ok = z > cfg.near_m
-        px = np.full(len(z), -1, np.int64)
-        py = np.full(len(z), -1, np.int64)
-        px[ok] = np.floor(v.K[0, 0] * pc[ok, 0] / z[ok] + v.K[0, 2] + 0.5).astype(np.int64)
-        py[ok] = np.floor(v.K[1, 1] * pc[ok, 1] / z[ok] + v.K[1, 2] + 0.5).astype(np.int64)
+        zi = np.where(ok, z, np.float32(1.0))
+        px = np.floor(np.float32(v.K[0, 0]) * pc[:, 0] / zi + np.float32(v.K[0, 2] + 0.5)).astype(np.int32)
+        py = np.floor(np.float32(v.K[1, 1]) * pc[:, 1] / zi + np.float32(v.K[1, 2] + 0.5)).astype(np.int32)
         ok &= (px >= 0) & (px < w) & (py >= 0) & (py < h)
         sel = np.flatnonzero(ok)
         rz = v.render_z[py[sel], px[sel]]
@@ -116,9 +127,12 @@ def carve(views: Sequence[HoleView], lo: np.ndarray, shape: tuple[int, int, int]
             read = dz > 0
             is_free = read & (zs < dz - margin)
             hole = ~read & ~behind_scan
-        free[sel[is_free]] += 1
-        missed[sel[hole]] += 1
-    return ((missed >= cfg.min_views) & (free <= cfg.max_free)).reshape(shape)
+        free[alive[sel[is_free]]] += 1
+        missed[alive[sel[hole]]] += 1
+        alive = alive[(free[alive] <= cfg.max_free) & (missed[alive] + left >= cfg.min_views)]
+    out = np.zeros(n, bool)
+    out[alive] = missed[alive] >= cfg.min_views
+    return out.reshape(shape)
 
 
 def island_vertices(mesh: TriMesh, max_area: float) -> np.ndarray:
@@ -462,6 +476,8 @@ def fill_missed_surface(mesh: TriMesh, frames: Sequence[Frame], raster: Rasteriz
                         cfg: MissedSurfaceConfig) -> tuple[TriMesh, list[MissedPlane]]:
     """``mesh`` with a coloured slab appended over every missed vertical plane (the mesh itself when none)."""
     views = hole_views(frames, raster, cfg)
+    if hole_share(views) < cfg.min_hole_share:
+        return mesh, []
     planes = seen_planes(merge_layers(missed_planes(mesh, frames, raster, cfg, views), cfg), views, cfg)
     if not planes:
         return mesh, []

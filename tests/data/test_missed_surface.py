@@ -10,7 +10,7 @@ import trimesh
 from react3d_core.config.scene_io import MissedSurfaceConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.raster import Rasterizer
-from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, island_vertices, merge_layers,
+from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, hole_share, island_vertices, merge_layers,
                                                   missed_planes, plane_cells, seen_planes, slab_mesh)
 
 W, H = 160, 120
@@ -162,3 +162,11 @@ def test_seen_planes_drops_a_slab_hidden_behind_another(corner):
     kept = seen_planes([front, behind], views, cfg)
     assert len(kept) == 1 and np.isclose(kept[0].point[1], 1.4)
     assert kept[0].area > 0.5
+
+
+def test_hole_share_gates_scans_without_missed_surfaces(corner):
+    _mesh, _r, views = corner
+    one = np.ones((2, 2), np.float32)
+    assert hole_share([HoleView(K, np.eye(4), one, one), HoleView(K, np.eye(4), one, np.array([[0, 1], [1, 1]], np.float32))]) == 0.125
+    assert hole_share([HoleView(K, np.eye(4), np.array([[0, 1], [0, 1]], np.float32), None)]) == 0.5  # no depth: scan holes
+    assert hole_share(views) > MissedSurfaceConfig().min_hole_share  # the black cabinet fills much of the views
