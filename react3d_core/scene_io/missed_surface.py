@@ -1,16 +1,17 @@
 """Surfaces the depth sensor missed: slabs over vertical planes the scan mesh lacks but the views show.
 
 ToF and structured-light sensors return no depth on black and glossy fronts, so a fused scan has holes
-where such fronts are (often nothing behind them either: the front hid it). Every later stage works on
-mesh faces, so a front the mesh lacks could never become a part. Here the holes are found from the
-views: a pixel whose ray hits no scan surface and whose depth frame has no reading looks at something
-the sensor missed. Space is carved on a voxel grid (a voxel is *free* when some view sees a scan surface
-or a depth reading behind it, *missed* when views look at it through such hole pixels); the missed
-voxels that no view saw through form the volumes the sensor missed. Their vertical faces towards the
-cameras are the missing surfaces: each is fitted with a vertical plane (moved onto the scan's own sparse
-returns on it, when there are any), rasterised on the plane, and added to the mesh as a flat slab
-coloured from the views. The original vertices and faces keep their ids (ground truth indexes them);
-the slab's are appended. Perception then finds fronts on the slab as on any other plane.
+where such fronts are, and every later stage works on mesh faces: a front the mesh lacks could never
+become a part. Here space is carved on a voxel grid from the views: a voxel looked at through pixels
+without a depth reading is *missed*, one seen in front of a reading is *free*; voxels missed by enough
+views and almost never free form the volumes the sensor missed. Those volumes reach well in front of the
+true surface where few views look obliquely, so they do not place it: the scan's own sparse returns on a
+dark front do (small islands of surface, unlike walls and floors). Vertical planes are fitted to the
+returns inside the volumes, each plane's region is the volume's section near its returns, layers of one
+surface (face, handles, worktop edge) are merged, regions are trimmed to what some view sees first
+through a pixel without reading, and each becomes a flat slab coloured from the views, appended to the
+mesh. The original vertices and faces keep their ids (ground truth indexes them). Perception then finds
+fronts on the slab as on any other plane.
 """
 
 from __future__ import annotations
