@@ -5,6 +5,41 @@ from pydantic import Field
 from ._base import StageConfig
 
 
+class MissedSurfaceConfig(StageConfig):
+    """Slabs over vertical surfaces the depth sensor missed (dark, glossy fronts): voxels seen through pixels
+    with neither scan surface nor depth reading, and never seen through to a surface, form the missed
+    volumes; their vertical faces towards the cameras become flat coloured slabs appended to the mesh
+    (react3d_core/scene_io/missed_surface.py)."""
+
+    enabled: bool = Field(True, description="Add slabs over vertical surfaces the sensor missed before any stage runs.")
+    min_hole_share: float = Field(0.08, ge=0, le=1, description="Skip the carving (a cost saver: up to a minute on a large kitchen) when the views' pixels without a depth reading are under this share on average: 0.03-0.06 on clean and TSDF held-apart scenes, whose sensors miss nothing, 0.40 on dark tuning 340.")
+    voxel_m: float = Field(0.03, gt=0, description="Side of the carving voxels (m).")
+    work_width: int = Field(160, ge=16, description="Width (px) of the renders and depth maps the carving reads.")
+    max_views: int = Field(24, ge=1, description="At most this many views (evenly chosen) carve and colour.")
+    min_views: int = Field(3, ge=1, description="A missed voxel is seen through hole pixels in at least this many views.")
+    max_free: int = Field(1, ge=0, description="...and seen in front of a scan surface or depth reading in at most this many.")
+    margin_m: float = Field(0.04, ge=0, description="A voxel is in front of a surface only when closer by more than this (m).")
+    near_m: float = Field(0.1, gt=0, description="Voxels closer to a camera than this (m) are not judged by it.")
+    min_area: float = Field(0.06, gt=0, description="Smallest missed vertical surface kept (m²): about a small drawer front.")
+    min_depth_m: float = Field(0.06, gt=0, description="A missed volume holds at least min_area x this (m³): thinner ones are noise.")
+    min_returns: int = Field(15, ge=3, description="A missed vertical plane is fixed by at least this many scan vertices on it (its sparse returns).")
+    max_island_m2: float = Field(0.1, gt=0, description="Returns are vertices of scan pieces under this area (m²): a missed front keeps islands, walls and floors are large.")
+    min_spread_m: float = Field(0.1, gt=0, description="A plane's returns spread over at least this (m, 10th-90th percentile) across and up.")
+    plane_tol_m: float = Field(0.015, gt=0, description="A return lies on a plane within this distance (m).")
+    ransac_iters: int = Field(400, ge=1, description="RANSAC hypotheses per vertical plane.")
+    refits: int = Field(3, ge=0, description="Times the best plane is refitted to its inliers (least squares).")
+    ransac_neighbours: int = Field(24, ge=2, description="A hypothesis pairs a return with one of its this many nearest returns.")
+    min_camera_share: float = Field(0.3, ge=0, le=1, description="A face is kept when at least this share of the views stands in front of it.")
+    return_reach_m: float = Field(0.4, gt=0, description="A plane's missed region reaches this far (m) from its returns: the sparse returns of a dark front lie all over it.")
+    max_scanned: float = Field(0.5, ge=0, le=1, description="A plane whose returns already cover more than this share of its region is scanned, not missed.")
+    merge_deg: float = Field(10.0, ge=0, le=90, description="Planes facing the same way within this angle may be layers of one surface.")
+    merge_m: float = Field(0.15, ge=0, description="...when their overlapping regions lie within this distance (m): the one with most returns is kept.")
+    res_m: float = Field(0.015, gt=0, description="Cell size of the slab raster (m).")
+    close_m: float = Field(0.07, ge=0, description="Gaps up to this (m) in a plane's region are closed.")
+    seed: int = Field(0, description="RANSAC seed (deterministic).")
+
+
+
 class FrameSelectionConfig(StageConfig):
     """Frame selection. Default (``stride`` None): keyframes by what the views add — camera motion since
     the last kept frame, then new or under-observed surface in a low-resolution face-id buffer — capped
@@ -22,3 +57,4 @@ class FrameSelectionConfig(StageConfig):
     coverage_voxel_m: float = Field(0.05, gt=0, description="Keyframe mode: surface is counted per voxel of this side (m) when measuring what a view adds (about one coverage-buffer pixel at 2 m).")
     coverage_min_new: float = Field(0.05, ge=0, le=1, description="Keyframe mode: keep a moved frame only if at least this fraction of its surface pixels is not yet covered.")
     image_width: int = Field(960, ge=32, description="RGB working width; the reference worked at 960x720. K is rescaled with it.")
+    missed_surface: MissedSurfaceConfig = Field(default_factory=MissedSurfaceConfig, description="Slabs over vertical surfaces the depth sensor missed (dark, glossy fronts).")

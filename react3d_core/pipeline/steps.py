@@ -38,11 +38,14 @@ class LoadedScene:
 
 
 def load(scene_path: str | Path, frames: FrameSelectionConfig,
-         raster_for: Callable[[str | Path], Rasterizer] | None = None, memo: SelectionMemo | None = None) -> LoadedScene:
+         raster_for: Callable[[str | Path], Rasterizer] | None = None, memo: SelectionMemo | None = None,
+         cache_dir: str | Path | None = None) -> LoadedScene:
     """Load and validate the scan (units included) and select its frames (keyframes by default).
 
     ``raster_for(mesh_path)``: where the scan's rasterizer comes from (a worker keeps one per mesh);
-    by default it is built here, once. ``memo``: remembered keyframe selections (``SelectionMemo``)."""
+    by default it is built here, once. ``memo``: remembered keyframe selections (``SelectionMemo``).
+    With ``frames.missed_surface.enabled`` the scan is completed with slabs over the surfaces the depth
+    sensor missed, kept under ``cache_dir`` (default ``$REACT3D_CACHE``), and every stage reads that mesh."""
     from ..scene_io import load_scene
     from ..scene_io.scale import check_scale
 
@@ -57,6 +60,14 @@ def load(scene_path: str | Path, frames: FrameSelectionConfig,
     scene = load_scene(scene_path, frames, rasterizer=raster_for, memo=memo)
     raster = raster_for(scene.mesh_path)
     check_scale(scene, raster.mesh)  # a millimetre mesh otherwise gives 0 parts, rc 0
+    if frames.missed_surface.enabled:
+        import os
+
+        from ..scene_io.missed_surface import complete_scene
+
+        root = cache_dir or os.environ.get("REACT3D_CACHE", Path.home() / ".cache" / "react3d")
+        scene = complete_scene(scene, raster, frames.missed_surface, root)
+        raster = raster_for(scene.mesh_path)
     return LoadedScene(scene, raster)
 
 

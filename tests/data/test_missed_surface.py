@@ -1,0 +1,172 @@
+"""Slabs over surfaces the depth sensor missed (react3d_core/scene_io/missed_surface.py), on hand-made scenes:
+a room corner whose scan lacks a black cabinet front except a few sparse returns."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from react3d_core.config.scene_io import MissedSurfaceConfig
+from react3d_core.data.mesh import TriMesh
+from react3d_core.raster import Rasterizer
+from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, hole_share, island_vertices, merge_layers,
+                                                  missed_planes, plane_cells, seen_planes, slab_mesh)
+
+W, H = 160, 120
+K = np.array([[120.0, 0, 79.5], [0, 120.0, 59.5], [0, 0, 1]])
+
+
+def _look_at(eye: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """Camera-to-world, OpenCV axes (x right, y down, z forward), z up world."""
+    z = target - eye
+    z /= np.linalg.norm(z)
+    x = np.cross(z, [0, 0, 1.0])
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    T = np.eye(4)
+    T[:3, :3] = np.stack([x, y, z], 1)
+    T[:3, 3] = eye
+    return T
+
+
+def _box(lo, hi) -> trimesh.Trimesh:
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    b = trimesh.creation.box(extents=hi - lo)
+    b.apply_translation((lo + hi) / 2)
+    return trimesh.Trimesh(*trimesh.remesh.subdivide_to_size(b.vertices, b.faces, 0.03))
+
+
+def _scene():
+    """A closed room (floor, ceiling, walls; back wall (y = 2) and a black cabinet (x 0.5..1.3, y 1.4..2, z 0..0.8) whose front is at
+    y = 1.4. The true scene renders the depth readings (none on the cabinet); the scan lacks the cabinet but
+    for a few front patches (its sparse returns)."""
+    floor = trimesh.util.concatenate([_box([-1, -1, -0.02], [3, 2, 0]), _box([-1, -1, 2.5], [3, 2, 2.52]),  # floor, ceiling
+                                      _box([-1.02, -1, 0], [-1, 2, 2.5]), _box([3, -1, 0], [3.02, 2, 2.5]),
+                                      _box([-1, -1.02, 0], [3, -1, 2.5])])  # side and front walls: a closed room
+    wall = _box([-1, 2, 0], [3, 2.02, 2.5])
+    cab = _box([0.5, 1.4, 0.0], [1.3, 2.0, 0.8])
+    true = trimesh.util.concatenate([floor, wall, cab])
+    n_bg = len(floor.faces) + len(wall.faces)
+    cen = cab.triangles_center
+    front = np.isclose(cen[:, 1], 1.4)
+    rng = np.random.default_rng(0)
+    patch = front & (rng.random(len(cen)) < 0.08)  # ~8 % of the front returned depth
+    scan = trimesh.util.concatenate([floor, wall, trimesh.Trimesh(cab.vertices, cab.faces[patch])])
+    true_r = Rasterizer(TriMesh(true.vertices, true.faces))
+    scan_mesh = TriMesh(scan.vertices, scan.faces)
+    scan_r = Rasterizer(scan_mesh)
+    views = []
+    for ex in (-0.4, 0.2, 0.9, 1.6, 2.2):
+        for ez in (1.0, 1.6):
+            c2w = _look_at(np.array([ex, -0.8, ez]), np.array([0.9, 1.7, 0.4]))
+            w2c = np.linalg.inv(c2w)
+            t = true_r.render(K, c2w, W, H)
+            reading = np.where(t.face_ids >= n_bg, 0.0, t.depth).astype(np.float32)  # black: no return
+            views.append(HoleView(K, w2c, scan_r.render(K, c2w, W, H).depth, reading))
+    return scan_mesh, scan_r, views
+
+
+@pytest.fixture(scope="module")
+def corner():
+    return _scene()
+
+
+def test_carve_keeps_the_missed_cabinet_and_frees_the_room(corner):
+    mesh, _r, views = corner
+    cfg = MissedSurfaceConfig()
+    lo = mesh.vertices.min(0)
+    shape = tuple(int(x) for x in np.ceil((mesh.vertices.max(0) - lo) / cfg.voxel_m))
+    occ = carve(views, lo, shape, cfg)
+    c = lo + (np.argwhere(occ) + 0.5) * cfg.voxel_m
+    inside = (c[:, 0] > 0.55) & (c[:, 0] < 1.25) & (c[:, 1] > 1.45) & (c[:, 2] > 0.05) & (c[:, 2] < 0.75)
+    assert inside.mean() > 0.3  # a third of the missed voxels is the cabinet itself...
+    # ...and nearly all lie in its footprint grown towards the cameras (few views look at its front obliquely)
+    near = (c[:, 0] > 0.3) & (c[:, 0] < 1.5) & (c[:, 1] > 0.9) & (c[:, 2] < 1.0)
+    assert near.mean() > 0.9
+    probe = np.floor((np.array([[0.9, 0.5, 0.4], [2.5, 1.5, 1.0]]) - lo) / cfg.voxel_m).astype(int)
+    assert not occ[tuple(probe.T)].any()  # open room in front of it and beside it: seen free
+
+
+def test_missed_plane_is_the_cabinet_front(corner):
+    mesh, r, views = corner
+    cfg = MissedSurfaceConfig(min_returns=10)
+    planes = missed_planes(mesh, [], r, cfg, views)
+    assert planes, "the cabinet front is missed by the scan and must be found"
+    p = max(planes, key=lambda q: q.area)
+    assert abs(abs(p.normal[1]) - 1) < 1e-6 and p.normal[1] < 0  # faces the cameras (-y)
+    assert abs(p.point[1] - 1.4) < 0.015
+    # its region spans the front (0.8 x 0.8 m) within about a voxel on each side
+    assert 0.45 < p.area < 0.9
+
+
+def test_slab_mesh_cells_hand_computed():
+    cells = np.zeros((3, 4), bool)
+    cells[0:2, 1:4] = True  # 2 rows x 3 columns
+    p = MissedPlane(point=np.array([0.0, 1.0, 0.0]), normal=np.array([0.0, -1.0, 0.0]), u=np.array([-1.0, 0.0, 0.0]),
+                    u0=0.0, v_top=1.0, res=0.1, cells=cells)
+    v, f = slab_mesh(p)
+    assert len(v) == 3 * 4 and len(f) == 2 * 6  # shared corners: (2+1) x (3+1)
+    assert np.allclose(v[:, 1], 1.0)  # on the plane
+    assert np.isclose(v[:, 2].max(), 1.0) and np.isclose(v[:, 2].min(), 0.8)
+    assert np.isclose(v[:, 0].max(), -0.1) and np.isclose(v[:, 0].min(), -0.4)  # columns 1..3 along u = -x
+    m = TriMesh(v, f)
+    assert np.isclose(m.face_areas.sum(), 6 * 0.01)
+    assert np.allclose(m.face_normals, [0, -1, 0])  # wound towards the cameras
+
+
+def test_plane_cells_fills_a_rectangle_of_voxels():
+    cfg = MissedSurfaceConfig()
+    xs, zs = np.meshgrid(np.arange(0.015, 0.6, 0.03), np.arange(0.015, 0.3, 0.03))
+    pts = np.stack([xs.ravel(), np.full(xs.size, 2.0), zs.ravel()], 1)
+    pts = pts[~((np.abs(pts[:, 0] - 0.3) < 0.04) & (np.abs(pts[:, 2] - 0.15) < 0.04))]  # a hole: filled
+    p = plane_cells(pts, np.array([0.0, 2.0, 0.0]), np.array([0.0, -1.0, 0.0]), cfg)
+    assert p is not None
+    assert abs(p.area - 0.6 * 0.3) < 0.02
+    small = plane_cells(pts[:4], np.array([0.0, 2.0, 0.0]), np.array([0.0, -1.0, 0.0]), cfg)
+    assert small is None  # under min_area
+
+
+def test_returns_are_islands_not_walls():
+    wall = _box([0, 0, 0], [2, 0.02, 2])  # 4 m² each side: one connected surface
+    chip = _box([3, 0, 0], [3.1, 0.01, 0.1])  # a 0.1 x 0.1 m patch: ~0.02 m² of surface
+    m = trimesh.util.concatenate([wall, chip])
+    isl = island_vertices(TriMesh(m.vertices, m.faces), 0.1)
+    assert not isl[:len(wall.vertices)].any() and isl[len(wall.vertices):].all()
+
+
+def _plane(y: float, x0: float, x1: float, z0: float, z1: float, n_returns: int, res: float = 0.05) -> MissedPlane:
+    w, h = int(round((x1 - x0) / res)), int(round((z1 - z0) / res))
+    return MissedPlane(point=np.array([0.0, y, 0.0]), normal=np.array([0.0, -1.0, 0.0]), u=np.array([-1.0, 0.0, 0.0]),
+                       u0=-x1, v_top=z1, res=res, cells=np.ones((h, w), bool), n_returns=n_returns)
+
+
+def test_merge_layers_keeps_the_plane_with_most_returns():
+    cfg = MissedSurfaceConfig(res_m=0.05)
+    front = _plane(1.4, 0.0, 0.8, 0.0, 0.8, n_returns=300)
+    handles = _plane(1.37, 0.1, 0.7, 0.3, 0.4, n_returns=40)  # 3 cm in front, overlapping
+    other = _plane(1.4, 2.0, 2.6, 0.0, 0.8, n_returns=50)  # same plane, elsewhere: its own surface
+    far = _plane(1.1, 0.0, 0.8, 0.0, 0.8, n_returns=60)  # 30 cm in front: another surface
+    kept = merge_layers([handles, other, front, far], cfg)
+    assert len(kept) == 3
+    assert kept[0].n_returns == 340 and np.isclose(kept[0].point[1], 1.4)
+    assert abs(kept[0].area - 0.64) < 0.05  # the handles' region lay inside the front's
+    assert {round(float(p.point[1]), 2) for p in kept[1:]} == {1.4, 1.1}
+
+
+def test_seen_planes_drops_a_slab_hidden_behind_another(corner):
+    _mesh, _r, views = corner
+    cfg = MissedSurfaceConfig()
+    front = _plane(1.4, 0.5, 1.3, 0.0, 0.8, n_returns=100, res=0.015)
+    behind = _plane(1.6, 0.8, 1.0, 0.3, 0.5, n_returns=100, res=0.015)  # inside the cabinet, hidden from every view
+    kept = seen_planes([front, behind], views, cfg)
+    assert len(kept) == 1 and np.isclose(kept[0].point[1], 1.4)
+    assert kept[0].area > 0.5
+
+
+def test_hole_share_gates_scans_without_missed_surfaces(corner):
+    _mesh, _r, views = corner
+    one = np.ones((2, 2), np.float32)
+    assert hole_share([HoleView(K, np.eye(4), one, one), HoleView(K, np.eye(4), one, np.array([[0, 1], [1, 1]], np.float32))]) == 0.125
+    assert hole_share([HoleView(K, np.eye(4), np.array([[0, 1], [0, 1]], np.float32), None)]) == 0.5  # no depth: scan holes
+    assert hole_share(views) > MissedSurfaceConfig().min_hole_share  # the black cabinet fills much of the views
