@@ -318,8 +318,8 @@ def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamC
 
 
 def _dips_in_every_piece(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamConfig) -> np.ndarray:
-    """Per line across ``axis``: whether its median brightness dips by ``contrast`` below the lines beside
-    it in every piece of its length (pieces ``piece_sides`` x ``min_px`` long; a piece where the line is
+    """Per line across ``axis``: whether its median brightness dips by ``piece_contrast`` below the lines
+    beside it in every piece of its length (pieces ``piece_sides`` x ``min_px`` long; a piece where the line is
     covered less than ``min_line_cover`` of its best-covered line there is not judged).
 
     Why: a line's median over the whole cell dips as soon as more than half of it is dark, so a seam
@@ -342,7 +342,7 @@ def _dips_in_every_piece(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int,
                 continue
             prof = np.where(ok, prof, np.median(prof[ok]))
             dip = ndimage.median_filter(prof, size=2 * min_px + 1, mode="nearest") - prof
-            out &= ~ok | (dip >= p.contrast)
+            out &= ~ok | (dip >= p.piece_contrast)
     return out
 
 

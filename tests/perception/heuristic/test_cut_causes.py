@@ -30,7 +30,7 @@ def test_line_dark_over_part_of_the_cell_is_no_straight_seam() -> None:
     over all 500): each line's median over the whole cell is 0.8, a dip of 0.2 below the rows beside it;
     the MAD of the dips is 0, floored at 1e-3, so both score 200 without the piece rule. With it (pieces
     3 x min_px = 75 px: 500 // 75 = 6 pieces of 83-84 px) row 70 is plain in the last two pieces (columns
-    333-499), so it scores 0; row 140 dips in every piece and keeps 200."""
+    333-499: a dip of 0 there, under piece_contrast), so it scores 0; row 140 dips in every piece and keeps 200."""
     g = np.ones((200, 500))
     g[70, :300] = 0.8
     g[140, :] = 0.8
@@ -105,7 +105,7 @@ def test_piece_of_a_fused_seam_is_no_handle() -> None:
     """A 0.8 x 0.8 m panel (4 mm px): a seam 4 px wide over the whole height, 5 % dark (below the handle
     contrast), 25 % dark over rows 120-179 (a 0.24 m x 16 mm dark bar there, as where the views of a fused
     seam disagree most), and a real bright bar 0.2 m x 2 cm 10 cm to its right. Without the seam rule both
-    are handles; with it (half of a blob on straight seam evidence longer than any handle) only the bar."""
+    are handles; with it (90 % of a blob on straight seam evidence longer than any handle) only the bar."""
     h = w = 200
     rng = np.random.default_rng(5)
     img = np.ones((h, w, 3), np.float32) + rng.normal(0, 0.003, (h, w, 3)).astype(np.float32)
