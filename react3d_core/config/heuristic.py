@@ -240,6 +240,8 @@ class SeamConfig(StageConfig):
     prominence: float = Field(0.3, ge=0, le=1, description="... and this much more than the lines around it (vertical seams).")
     prominence_h: float = Field(0.5, ge=0, le=1, description="The same for horizontal seams (reflections of table/shelf edges are horizontal).")
     dip_z: float = Field(15.0, ge=0, description="A straight seam: the line's median brightness dips this many noise units below the lines beside it (found through wood grain).")
+    piece_sides: int = Field(3, ge=0, description="... and its median dips by piece_contrast in every piece of its length this many cells.min_side long (0.3 m at 0.1 m): a seam of stacked drawers that spans most of a run does not cut the door beside them. 0: off.")
+    piece_contrast: float = Field(0.0005, ge=0, description="How far (fraction of the plane's mean) a straight seam's median dips at least in each piece: a plain door face beside a drawer seam does not dip at all there (clean kitchen 100: -0.1 to 0.0 %); at 0.25 % RedKitchen's 2 cm clustered copy lost two faint seams (4 / 1 -> 2 / 1).")
     min_line_cover: float = Field(0.3, ge=0, le=1, description="Straight seams and colour steps: lines less covered than this share of the best-covered line score 0.")
     noise_floor: float = Field(0.001, gt=0, description="Noise units of straight seams and colour steps are at least this (brightness / colour distance).")
     step_contrast: float = Field(0.25, ge=0, description="A colour step along a whole line (a door leaf in a pale wall) cuts when its colour distance is at least this ...")
@@ -290,6 +292,7 @@ class HandleConfig(StageConfig):
     bar_close_px: int = Field(5, ge=1, description="A mesh handle's splatted face centroids are closed with a kernel of this many px (they sit half a face inside its outline).")
     shadows: bool = Field(True, description="On a front without a seen handle, an enclosed horizontal unseen hole of handle size above the cameras' median height is the handle's scanning shadow (a bar seen from below hides the front behind it in every view); it types the joint (wall-cabinet flaps), it does not cut cells.")
     shadow_min_thick: float = Field(0.03, ge=0, description="A handle's scanning shadow is at least this tall (m).")
+    seam_share: float = Field(0.9, ge=0, le=1, description="A blob with at least this share of its pixels on straight seam evidence longer than any handle is a piece of a seam, not a handle (a fused seam is 3-5 px wide; where only part of it passes the contrast it is a bar-sized blob). At 0.5 a RedKitchen bar beside a door seam went too (every 4th frame: 6 / 4 -> 5 / 5). 0: off.")
 
 
 class CellConfig(StageConfig):

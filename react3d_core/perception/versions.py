@@ -19,6 +19,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 # configuration a run uses is part of the cache key)
 # 15: holes in a plane's coverage framed all round by a door-frame wide band count as covered (glass
 #     panes the scan lacks; image.pane_*)
-HEURISTIC_VERSION = "15"
+# 16: a straight seam dips in every 0.3 m piece of its length (seams.piece_*), the cut between stacked
+#     handles is sought between their centres, a front's own handles are no clutter in the mesh-front veto,
+#     a blob lying on a long straight seam is no handle (handles.seam_share)
+HEURISTIC_VERSION = "16"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -174,6 +174,7 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
     n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=CONNECTIVITY)
     out = []
+    seams = None
     for j in range(1, n):
         x, y, w, h, area = stats[j]
         long_, short = max(w, h) * o.res, min(w, h) * o.res
@@ -181,6 +182,10 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
             continue
         if max(w, h) < p.aspect * min(w, h) or area < p.min_fill * w * h:
             continue
+        if p.seam_share > 0:
+            seams = _long_seams(o, cfg, L) if seams is None else seams
+            if (seams[y:y + h, x:x + w][lab[y:y + h, x:x + w] == j]).mean() >= p.seam_share:
+                continue
         # a handle sits on the front: mesh coverage around it on both sides across its length
         pad = max(2, int(p.side_band / o.res))
         r0, r1, c0, c1 = max(0, y - pad), min(lab.shape[0], y + h + pad), max(0, x - pad), min(lab.shape[1], x + w + pad)
@@ -192,6 +197,20 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1)))
     return out
+
+
+def _long_seams(o: Orthophoto, cfg: HeuristicConfig, length_px: int) -> np.ndarray:
+    """Pixels on straight seam evidence (``seam_maps``) running at least ``length_px`` (longer than any handle)
+    along a column or a row.
+
+    Why: a seam between two fronts fused from views a pixel or two apart is a dark line 3-5 px wide, and
+    where only part of it is dark enough to pass the handle contrast, that part is a 0.25 m x 16 mm dark bar
+    (clean kitchen 101: one on the gap between two wall-cabinet doors split the left door at a false handle).
+    The seam evidence runs on along the whole seam where the handle contrast breaks off."""
+    vert, horiz = seam_maps(o, cfg)
+    lv = cv2.morphologyEx(vert.astype(np.uint8), cv2.MORPH_OPEN, np.ones((length_px, 1), np.uint8))
+    lh = cv2.morphologyEx(horiz.astype(np.uint8), cv2.MORPH_OPEN, np.ones((1, length_px), np.uint8))
+    return (lv | lh).astype(bool)
 
 
 def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int) -> tuple[float, float]:
@@ -294,7 +313,37 @@ def _dip_scores(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamC
     prof = np.where(ok, prof, np.median(prof[ok]))
     dip = ndimage.median_filter(prof, size=2 * min_px + 1, mode="nearest") - prof
     noise = max(MAD_SIGMA * float(np.median(np.abs(dip[ok] - np.median(dip[ok])))), p.noise_floor)
-    return np.where(ok & (dip >= p.contrast), dip / noise, 0.0)
+    whole = _dips_in_every_piece(g, cov, axis, min_px, p) if p.piece_sides > 0 else True
+    return np.where(ok & (dip >= p.contrast) & whole, dip / noise, 0.0)
+
+
+def _dips_in_every_piece(g: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamConfig) -> np.ndarray:
+    """Per line across ``axis``: whether its median brightness dips by ``piece_contrast`` below the lines
+    beside it in every piece of its length (pieces ``piece_sides`` x ``min_px`` long; a piece where the line is
+    covered less than ``min_line_cover`` of its best-covered line there is not judged).
+
+    Why: a line's median over the whole cell dips as soon as more than half of it is dark, so a seam
+    between stacked drawers that spans 60 % of a run cut the door beside them, whose face shows no step
+    there. A seam runs along the whole cell; a line dark in one piece and plain in the next is none."""
+    length = cov.shape[axis]
+    n_pieces = max(1, length // max(1, p.piece_sides * min_px))
+    out = np.ones(cov.shape[1 - axis], bool)
+    if n_pieces < 2:
+        return out
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN lines of a piece are not judged
+        for gp, cp in zip(np.array_split(g, n_pieces, axis), np.array_split(cov, n_pieces, axis)):
+            n = cp.sum(axis)
+            if not n.any():
+                continue
+            prof = np.nanmedian(np.where(cp, gp, np.nan), axis)
+            ok = (n >= p.min_line_cover * n.max()) & np.isfinite(prof)
+            if ok.sum() < _MIN_LINES:
+                continue
+            prof = np.where(ok, prof, np.median(prof[ok]))
+            dip = ndimage.median_filter(prof, size=2 * min_px + 1, mode="nearest") - prof
+            out &= ~ok | (dip >= p.piece_contrast)
+    return out
 
 
 def _step_scores(c: np.ndarray, cov: np.ndarray, axis: int, min_px: int, p: SeamConfig) -> np.ndarray:
@@ -462,20 +511,24 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
 
 
 def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: SeamConfig,
-             learned: np.ndarray | None = None, span: float = 1.0) -> int:
+             learned: np.ndarray | None = None, span: float = 1.0, centres: tuple[int, int] | None = None) -> int:
     """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the line ``learned`` line
     evidence covers most, when it covers at least ``span`` of the cell; else the strongest straight seam
-    (``_dip_scores`` >= ``between_z`` noise units), else the most seam-like line by valley counts
-    (covering more than ``between_span``), else the middle."""
+    (``_dip_scores`` >= ``between_z`` noise units), sought between the handles' ``centres`` when given
+    (a handle's box, grown by the bar closing and blurred by misregistration, reaches a few px over the
+    seam beside it: a drawer's seam just above the handle of the door below was outside [lo, hi) and the
+    cut fell halfway up the drawer); else the most seam-like line by valley counts (covering more than
+    ``between_span``), else the middle."""
     if hi - lo < 1:
         return (lo + hi) // 2
     if learned is not None:
         prof = _profile(learned, cov, axis)[lo:hi]
         if prof.max() >= span:
             return lo + _plateau_middle(prof)
-    z = _dip_scores(g, cov, axis, min_px, p)[lo:hi]
-    if z.max() >= p.between_z:
-        return lo + int(np.argmax(z))
+    a, b = (lo, hi) if centres is None else (min(lo, centres[0] + 1), max(hi, centres[1]))
+    z = _dip_scores(g, cov, axis, min_px, p)[a:b]
+    if len(z) and z.max() >= p.between_z:
+        return a + int(np.argmax(z))
     sl = (slice(None), slice(lo, hi)) if axis == 0 else (slice(lo, hi), slice(None))
     prof = _profile(ev[sl], cov[sl], axis)
     return lo + int(np.argmax(prof)) if prof.max() > p.between_span else (lo + hi) // 2
@@ -501,7 +554,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
             lo, hi = int(xs[k]), int(xs[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
         cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
-                              None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span)
+                              None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
+                              (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0))
         a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):
@@ -515,7 +569,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
             lo, hi = int(ys[k]), int(ys[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
         cut = c.r0 + _between(g[rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p,
-                              None if learned is None else learned.horiz[rs, cs], 1.0 if learned is None else learned.span)
+                              None if learned is None else learned.horiz[rs, cs], 1.0 if learned is None else learned.span,
+                              (int(ys[k]) - c.r0, int(ys[k + 1]) - c.r0))
         a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1):

@@ -322,12 +322,12 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
         cov = cov | framed_panes(cov, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area)
         diff = off_background(o, hc)
-        diffs.append(diff)
         outline = cov_outline(cov, cfg.image.outline_fill_px)  # handle shadows are holes in the plane, not its outline
         win = hc.background_win if hc.protrusion_from_surface else 0.0
         bars = (protrusion_map(o, surf, hc, win, cfg.planes.offset_tol) if cfg.image.surface_rays
                 else protrusion_from_faces(o, centroids, mesh.face_normals, hc, win, cfg.planes.offset_tol))
         handles = find_handles(o, cov, cfg, diff, bars & outline, outline)
+        diffs.append(_without_handles(diff, handles))
         shadows: list[Handle] = []
         if hc.shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
             eye_row = int(np.floor((o.v_top - float(np.median(cams[:, 2]))) / o.res))  # cameras' median height
@@ -415,10 +415,23 @@ def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh
     return kept, split
 
 
+def _without_handles(diff: np.ndarray, handles: Sequence[Handle]) -> np.ndarray:
+    """``diff`` with the handles' pixels set to 0: what the mesh-front veto (``_cluttered``) counts. A front's
+    own handle is no clutter: a 0.3 x 0.03 m bar fills an eighth of a 0.4 x 0.18 m drawer, which with a few
+    off pixels along its edges passed ``clutter.max_share`` and the drawer was vetoed (clean kitchen 101)."""
+    if not handles:
+        return diff
+    out = diff.copy()
+    for h in handles:
+        out[h.pixels[:, 1], h.pixels[:, 0]] = 0.0
+    return out
+
+
 def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarray], cfg: HeuristicConfig) -> bool:
     """A mesh front whose picture is cluttered (a tiled wall with a socket "handle") is not a front:
     its rectangle in the orthophoto of its plane has more than ``clutter.max_share`` off-background pixels
-    (``diffs``: each orthophoto's off-background map, computed once; ``image.veto_*``: which plane, how much seen)."""
+    (``diffs``: each orthophoto's off-background map, computed once, its handles left out; ``image.veto_*``:
+    which plane, how much seen)."""
     im = cfg.image
     for o, diff_o in zip(orthos, diffs):
         p = o.plane
