@@ -40,11 +40,12 @@ def fit_part(points: np.ndarray, camera: np.ndarray, plane_normal: np.ndarray | 
              upright_tolerance: float = 0.0, triangles: np.ndarray | None = None, sparse_end_density: float = 0.0,
              sparse_end_min_m: float = 0.02) -> PartFit:
     """Min-area OBB (upright for a vertical front unless the minimal box is more than ``upright_tolerance``
-    smaller, :func:`.upright.upright_box`); n_front = u1 x u2 oriented into the cavity: along the clipping
-    plane's normal when the segmentation gave one, else away from the camera that segmented the part.
+    smaller, or whenever the clipping plane says the front is vertical, :func:`.upright.upright_box`);
+    n_front = u1 x u2 oriented into the cavity: along the clipping plane's normal when the segmentation gave
+    one, else away from the camera that segmented the part.
     With the part's ``triangles`` and ``sparse_end_density`` > 0, the box's front sides end where its surface
     does (:func:`.obb.trim_sparse_ends`)."""
-    obb = upright_box(points, min_obb(points), upright_tolerance)
+    obb = upright_box(points, min_obb(points), upright_tolerance, plane_normal=plane_normal)
     if triangles is not None and sparse_end_density > 0:
         obb = trim_sparse_ends(obb, triangles, min_density=sparse_end_density, min_trim_m=sparse_end_min_m)
     n = obb.R[:, 2].copy()

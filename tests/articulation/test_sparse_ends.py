@@ -97,3 +97,36 @@ def test_the_flap_hinge_lands_on_its_own_bottom_edge_not_on_the_sliver() -> None
     fit = fit_part(pts, camera, (0.0, 1.0, 0.0), 0.5, triangles=tris, sparse_end_density=0.1, sparse_end_min_m=0.02)
     art = refine_articulation(initial, fit)
     assert abs(art.origin[2] - Z0) <= 0.006
+
+
+def tilted_box(angle_deg: float) -> tuple[np.ndarray, "OBB"]:  # noqa: F821
+    """A drawer front 1.0 wide (y), 0.19 tall, 2 cm thick facing -x, and the box of it rotated ``angle_deg``
+    about the width axis (what a stray triangle reaching behind one corner made the smallest)."""
+    from react3d_core.data.parts import OBB
+
+    g = np.random.default_rng(0)
+    pts = np.stack([g.uniform(-0.01, 0.01, 3000), g.uniform(-0.5, 0.5, 3000), g.uniform(0.35, 0.54, 3000)], 1)
+    a = np.radians(angle_deg)
+    n = np.array([np.cos(a), 0.0, -np.sin(a)])
+    up = np.array([np.sin(a), 0.0, np.cos(a)])
+    R = np.stack([[0.0, 1.0, 0.0], up, n])  # rows s1 (width), s2, s3 (normal)
+    local = pts @ R.T
+    lo, hi = local.min(0), local.max(0)
+    return pts, OBB(center=tuple(((lo + hi) / 2) @ R), axes=tuple(map(tuple, R)), extents=tuple(hi - lo))
+
+
+def test_a_vertical_clipping_plane_makes_a_tilted_box_upright() -> None:
+    from react3d_core.articulation.upright import upright_box
+
+    pts, tilted = tilted_box(16.0)
+    # no plane: the 16-degree box is beyond the tilt the volume rule considers, so it stays (the failure)
+    assert upright_box(pts, tilted, 0.1) == tilted
+    up = upright_box(pts, tilted, 0.1, plane_normal=(1.0, 0.0, 0.0))
+    assert abs(up.R[2, 2]) < 1e-9 and abs(abs(up.R[0, 2]) - 1) < 1e-9  # normal horizontal, along the plane's
+    assert abs(up.extents[2] - 0.02) < 1e-3 and abs(up.extents[1] - 0.19) < 2e-3
+    # a plane that leans (10 degrees) is no evidence of a vertical front: the box stays
+    lean = (np.cos(np.radians(10)), 0.0, -np.sin(np.radians(10)))
+    assert upright_box(pts, tilted, 0.1, plane_normal=lean) == tilted
+    # a box already along the plane (2 degrees off) is left to the volume rule, and tolerance 0 is the paper's box
+    pts2, near = tilted_box(2.0)
+    assert upright_box(pts2, near, 0.0, plane_normal=(1.0, 0.0, 0.0)) == near
