@@ -242,6 +242,24 @@ def test_interleaved_carcass_walls_are_moved_to_their_side_not_dropped():
     assert len(kept) == 2  # the moved floor and the cut side; the far plate is dropped
 
 
+def test_a_wall_at_an_angle_to_the_plane_is_not_moved_by_its_depth():
+    from react3d_core.export.model import shift_walls
+
+    # a cupboard's roof 0.74 m deep (x), z 0.346..0.355, under a plane tilted 8 degrees (the bisector with a
+    # drawer front estimated 16 degrees off level): the roof lies wholly past it, but 10 cm deep along m.
+    # Moved until its far face met the plane it would sit 12 cm down, in the middle of its own cavity.
+    t = np.radians(8.0)
+    m = np.array([-np.sin(t), 0.0, -np.cos(t)])  # the cupboard keeps m . x <= c (below the plane)
+    roof = cube([4.081, 4.05, 0.346], [4.825, 4.38, 0.355])
+    c = float((roof.vertices @ m).min()) - 0.005  # its nearest corner 5 mm past the plane
+    (out,) = shift_walls([roof], m, c)
+    assert out is roof
+    thin = cube([4.081, 4.05, 0.346], [4.125, 4.38, 0.355])  # a wall thin along m is still moved onto the plane
+    c = float((thin.vertices @ m).min()) - 0.005
+    (moved,) = shift_walls([thin], m, c)
+    assert float((moved.vertices @ m).max()) == pytest.approx(c)
+
+
 def test_fronts_apart_only_when_the_plane_parts_them():
     from react3d_core.export.model import fronts_apart
 
