@@ -195,6 +195,28 @@ def test_a_box_cut_along_its_own_axis_stays_a_box() -> None:
     assert out.box is None and gap(out.vertices, piece_axes(out), ob)[0] >= 0.005 - 1e-9
 
 
+def test_territory_plane_of_side_by_side_fronts_with_one_normal_flipped_lies_across_the_row() -> None:
+    # two doors side by side in the plane y = 0.5 (x in [0, 0.5] and [0.5015, 1], z in [0, 0.8]), the door
+    # fronts' own vertices a few mm deep (front and back face); the second door's normal estimated flipped.
+    # The bisector of the two normals is a plane y = const through both fronts (it cut a door's colliders
+    # away); the plane must be x = 0.50075, across the row
+    a = np.array([[x, y, z] for x in (0.0, 0.5) for y in (0.5, 0.502, 0.503) for z in (0.0, 0.8)])
+    b = a + np.array([0.5015, -0.004, 0.0])
+    for tilt in (0.0, 5.0):  # exactly opposite, or 5 degrees further off
+        t = np.radians(tilt)
+        m, c = territory_plane(a, np.array([0, 1.0, 0]), b, np.array([np.sin(t), -np.cos(t), 0]), axes=np.eye(3))
+        assert m[0] > np.cos(np.radians(3.0))  # across the row (2.5 degrees off x with the 5-degree tilt)
+        assert (a @ m).max() <= c <= (b @ m).min()
+        if tilt == 0.0:
+            np.testing.assert_allclose(m, [1, 0, 0], atol=1e-12)
+            assert c == pytest.approx(0.50075)
+    # back to back (carcasses meeting behind them): the bisector, y = 0.3, between them
+    back = np.array([[x, 0.6, z] for x in (0.0, 0.5) for z in (0.0, 0.8)])
+    m, c = territory_plane(a[a[:, 1] == 0.5] - [0, 0.5, 0], np.array([0, 1.0, 0]), back, np.array([0, -1.0, 0]), axes=np.eye(3))
+    np.testing.assert_allclose(m, [0, 1, 0], atol=1e-12)
+    assert c == pytest.approx(0.3)
+
+
 def test_territory_plane_lies_across_the_axis_that_separates_the_fronts() -> None:
     # a tall door (x in [0, 0.5], z in [0, 0.8]) beside a short drawer high up (x in [0.5015, 1], z in [0.6, 0.8]):
     # the line between their centres is 32 degrees off the row; the plane must be x = 0.50075
