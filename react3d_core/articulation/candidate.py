@@ -37,17 +37,17 @@ class PartFit:
 
 
 def fit_part(points: np.ndarray, camera: np.ndarray, plane_normal: np.ndarray | None, flat_ratio: float,
-             upright_tolerance: float = 0.0, triangles: np.ndarray | None = None, sparse_end_density: float = 0.0,
-             sparse_end_min_m: float = 0.02) -> PartFit:
+             upright_tolerance: float = 0.0, triangles: np.ndarray | None = None,
+             sparse_end: tuple[float, float] | None = None) -> PartFit:
     """Min-area OBB (upright for a vertical front unless the minimal box is more than ``upright_tolerance``
     smaller, or whenever the clipping plane says the front is vertical, :func:`.upright.upright_box`);
     n_front = u1 x u2 oriented into the cavity: along the clipping plane's normal when the segmentation gave
     one, else away from the camera that segmented the part.
-    With the part's ``triangles`` and ``sparse_end_density`` > 0, the box's front sides end where its surface
-    does (:func:`.obb.trim_sparse_ends`)."""
+    With the part's ``triangles`` and ``sparse_end`` (density share, shortest end cut, m), the box's front
+    sides end where its surface does (:func:`.obb.trim_sparse_ends`)."""
     obb = upright_box(points, min_obb(points), upright_tolerance, plane_normal=plane_normal)
-    if triangles is not None and sparse_end_density > 0:
-        obb = trim_sparse_ends(obb, triangles, min_density=sparse_end_density, min_trim_m=sparse_end_min_m)
+    if triangles is not None and sparse_end is not None and sparse_end[0] > 0:
+        obb = trim_sparse_ends(obb, triangles, min_density=sparse_end[0], min_trim_m=sparse_end[1])
     n = obb.R[:, 2].copy()
     if plane_normal is not None:
         n *= 1.0 if np.dot(n, plane_normal) >= 0 else -1.0
@@ -119,8 +119,8 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
     cam = next((f.c2w[:3, 3] for f in scene.frames if f.frame_id == seg_id), frame.c2w[:3, 3])
     tris = mesh.vertices[mesh.faces[np.asarray(candidate.face_ids, np.int64)]]
     ac = config.articulation
-    fit = fit_part(pts, cam, candidate.plane_normal, ac.flat_ratio, ac.upright_tolerance, tris, ac.sparse_end_density,
-                   ac.sparse_end_min_m)
+    fit = fit_part(pts, cam, candidate.plane_normal, ac.flat_ratio, ac.upright_tolerance, tris,
+                   (ac.sparse_end_density, ac.sparse_end_min_m))
     obb, n, thickness, flat = fit.obb, fit.front_normal, fit.thickness, fit.flat
     sliding = bool(pred.sliding and pred.joint_type == "prismatic") and sliding_agrees(
         initial.axis, obb, n, candidate.label, config.articulation.sliding_min_height_m)

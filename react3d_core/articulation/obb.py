@@ -94,14 +94,13 @@ def _sorted_box(center: np.ndarray, axes: np.ndarray, ext: np.ndarray) -> OBB:
     return OBB(center=tuple(center), axes=tuple(map(tuple, R.T)), extents=tuple(ext[order]))
 
 
-def surface_samples(triangles: np.ndarray, n: int = 20000, seed: int = 0) -> np.ndarray:
-    """``n`` points spread uniformly over the area of ``triangles`` (m,3,3), seeded: the surface's own
+def surface_samples(triangles: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
+    """``n`` points spread uniformly over the area of ``triangles`` (m,3,3): the surface's own
     distribution, whatever its tessellation."""
     tri = np.asarray(triangles, float)
     area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1) / 2
     if not len(tri) or area.sum() <= 0:
         return np.zeros((0, 3))
-    rng = np.random.default_rng(seed)
     i = rng.choice(len(tri), n, p=area / area.sum())
     s, r = np.sqrt(rng.random(n)), rng.random(n)
     return tri[i, 0] * (1 - s)[:, None] + tri[i, 1] * (s * (1 - r))[:, None] + tri[i, 2] * (s * r)[:, None]
@@ -117,8 +116,8 @@ def dense_span(x: np.ndarray, bin_m: float, min_density: float) -> tuple[float, 
     return float(edges[dense[0]]), float(edges[dense[-1] + 1])
 
 
-def trim_sparse_ends(obb: OBB, triangles: np.ndarray, bin_m: float = 0.005, min_density: float = 0.1,
-                     min_trim_m: float = 0.02, samples: int = 20000) -> OBB:
+def trim_sparse_ends(obb: OBB, triangles: np.ndarray, min_density: float, min_trim_m: float, bin_m: float = 0.005,
+                     samples: int = 20000) -> OBB:
     """``obb`` ending where the part's surface does along its two front sides (s1, s2).
 
     A mask's edge on a scan mesh takes whole triangles, and one that bridges the seam to a neighbour (a
@@ -126,7 +125,7 @@ def trim_sparse_ends(obb: OBB, triangles: np.ndarray, bin_m: float = 0.005, min_
     hinge, the cavity and the front then lie partly in front of the other part. Along each front side, an
     end whose surface is sparse (bins under ``min_density`` of the median, by area, not by vertex count) for
     at least ``min_trim_m`` is cut off the box; the thickness axis is left alone (handles)."""
-    samples_xyz = surface_samples(triangles, samples)
+    samples_xyz = surface_samples(triangles, samples, np.random.default_rng(0))  # fixed: the same box every run
     if len(samples_xyz) < 100:
         return obb
     R, c, ext = obb.R, np.asarray(obb.center, float), np.asarray(obb.extents, float)

@@ -205,7 +205,7 @@ def enclosing_cut(big: OBB, big_faces: np.ndarray, small: OBB, vertices: np.ndar
     if area_share <= 0 or area_share >= 0.5:
         return None  # small is no smaller in the plane: a duplicate, the earlier stages' business
     own = np.asarray(big_faces, np.int64)
-    pts = surface_samples(vertices[faces[own]], samples) if len(own) else np.zeros((0, 3))
+    pts = surface_samples(vertices[faces[own]], samples, np.random.default_rng(0)) if len(own) else np.zeros((0, 3))
     if len(pts) < 100:
         return None
     fill = float(_footprint_mask(pts, small, cfg.motion_slab_m).mean()) / area_share

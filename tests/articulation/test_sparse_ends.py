@@ -44,10 +44,10 @@ def test_surface_samples_follow_area_not_vertices() -> None:
     for _ in range(3):
         v, f = trimesh.remesh.subdivide(v, f)
     tris = np.concatenate([big, np.asarray(v)[np.asarray(f)]])
-    p = surface_samples(tris, 20000, seed=1)
+    p = surface_samples(tris, 20000, np.random.default_rng(1))
     share = float(np.mean(p[:, 0] > p[:, 1]))  # below the diagonal: the big triangle
     assert abs(share - 0.5) < 0.02
-    assert np.array_equal(p, surface_samples(tris, 20000, seed=1))  # seeded
+    assert np.array_equal(p, surface_samples(tris, 20000, np.random.default_rng(1)))  # seeded
 
 
 def test_dense_span_hand_made() -> None:
@@ -61,7 +61,7 @@ def test_a_sliver_below_a_flap_is_cut_off_its_box() -> None:
     tris = np.concatenate([front_triangles(), sliver(0.1)])
     full = min_obb(tris.reshape(-1, 3))
     assert z_range(full)[0] < Z0 - 0.09  # the vertices' box reaches 10 cm down over the neighbour
-    trimmed = trim_sparse_ends(full, tris)
+    trimmed = trim_sparse_ends(full, tris, 0.1, 0.02)
     lo, hi = z_range(trimmed)
     assert abs(lo - Z0) <= 0.006 and abs(hi - (Z0 + H)) <= 1e-6
     assert np.allclose(sorted(trimmed.extents), [T, H, W], atol=0.006)  # width and thickness kept
@@ -72,19 +72,19 @@ def test_a_plain_front_keeps_its_box_however_coarse_its_mesh() -> None:
     for sub in (0, 4):  # 12 triangles, or thousands
         tris = front_triangles(sub)
         obb = min_obb(tris.reshape(-1, 3))
-        assert trim_sparse_ends(obb, tris) == obb
+        assert trim_sparse_ends(obb, tris, 0.1, 0.02) == obb
 
 
 def test_a_short_sparse_end_and_a_handle_stay() -> None:
     tris = np.concatenate([front_triangles(), sliver(0.015)])  # under the 2 cm minimum
     obb = min_obb(tris.reshape(-1, 3))
-    assert trim_sparse_ends(obb, tris) == obb
+    assert trim_sparse_ends(obb, tris, 0.1, 0.02) == obb
     # a bar handle 3 cm proud of the front (along the thickness axis) is never trimmed
     handle = trimesh.creation.box(extents=(0.3, 0.03, 0.02))
     handle.apply_translation((0.0, -T / 2 - 0.015, Z0 + H - 0.05))
     tris = np.concatenate([front_triangles(), np.asarray(handle.vertices)[np.asarray(handle.faces)]])
     obb = min_obb(tris.reshape(-1, 3))
-    assert trim_sparse_ends(obb, tris) == obb
+    assert trim_sparse_ends(obb, tris, 0.1, 0.02) == obb
 
 
 def test_the_flap_hinge_lands_on_its_own_bottom_edge_not_on_the_sliver() -> None:
@@ -94,7 +94,7 @@ def test_the_flap_hinge_lands_on_its_own_bottom_edge_not_on_the_sliver() -> None
     initial = Articulation(joint_type="revolute", axis=(1.0, 0.0, 0.0), origin=(0.0, 0.0, Z0 + 0.02), lower=0.0, upper=0.0)
     plain = refine_articulation(initial, fit_part(pts, camera, (0.0, 1.0, 0.0), 0.5))
     assert plain.origin[2] < Z0 - 0.09  # without the trim: the hinge 10 cm low, in front of the neighbour
-    fit = fit_part(pts, camera, (0.0, 1.0, 0.0), 0.5, triangles=tris, sparse_end_density=0.1, sparse_end_min_m=0.02)
+    fit = fit_part(pts, camera, (0.0, 1.0, 0.0), 0.5, triangles=tris, sparse_end=(0.1, 0.02))
     art = refine_articulation(initial, fit)
     assert abs(art.origin[2] - Z0) <= 0.006
 
