@@ -16,7 +16,7 @@ from ..data.frames import SceneInput
 from ..data.masks import ArticulationPrediction
 from ..data.mesh import TriMesh
 from ..data.parts import OBB, Articulation, PartCandidate
-from .obb import min_obb
+from .obb import min_obb, trim_sparse_ends
 from .refine import is_flat, refine_prismatic, refine_revolute, refine_sliding, slab_mid_and_thickness
 from .sliding import sliding_agrees
 from .trim import trim_to_prediction
@@ -37,11 +37,17 @@ class PartFit:
 
 
 def fit_part(points: np.ndarray, camera: np.ndarray, plane_normal: np.ndarray | None, flat_ratio: float,
-             upright_tolerance: float = 0.0) -> PartFit:
+             upright_tolerance: float = 0.0, triangles: np.ndarray | None = None,
+             sparse_end: tuple[float, float] | None = None) -> PartFit:
     """Min-area OBB (upright for a vertical front unless the minimal box is more than ``upright_tolerance``
-    smaller, :func:`.upright.upright_box`); n_front = u1 x u2 oriented into the cavity: along the clipping
-    plane's normal when the segmentation gave one, else away from the camera that segmented the part."""
-    obb = upright_box(points, min_obb(points), upright_tolerance)
+    smaller, or whenever the clipping plane says the front is vertical, :func:`.upright.upright_box`);
+    n_front = u1 x u2 oriented into the cavity: along the clipping plane's normal when the segmentation gave
+    one, else away from the camera that segmented the part.
+    With the part's ``triangles`` and ``sparse_end`` (density share, shortest end cut, m), the box's front
+    sides end where its surface does (:func:`.obb.trim_sparse_ends`)."""
+    obb = upright_box(points, min_obb(points), upright_tolerance, plane_normal=plane_normal)
+    if triangles is not None and sparse_end is not None and sparse_end[0] > 0:
+        obb = trim_sparse_ends(obb, triangles, min_density=sparse_end[0], min_trim_m=sparse_end[1])
     n = obb.R[:, 2].copy()
     if plane_normal is not None:
         n *= 1.0 if np.dot(n, plane_normal) >= 0 else -1.0
@@ -111,7 +117,10 @@ def articulate_candidate(scene: SceneInput, mesh: TriMesh, candidate: PartCandid
     pts = mesh.vertices[np.asarray(candidate.vertex_ids, np.int64)]
     seg_id = candidate.seg_frame_id or view
     cam = next((f.c2w[:3, 3] for f in scene.frames if f.frame_id == seg_id), frame.c2w[:3, 3])
-    fit = fit_part(pts, cam, candidate.plane_normal, config.articulation.flat_ratio, config.articulation.upright_tolerance)
+    tris = mesh.vertices[mesh.faces[np.asarray(candidate.face_ids, np.int64)]]
+    ac = config.articulation
+    fit = fit_part(pts, cam, candidate.plane_normal, ac.flat_ratio, ac.upright_tolerance, tris,
+                   (ac.sparse_end_density, ac.sparse_end_min_m))
     obb, n, thickness, flat = fit.obb, fit.front_normal, fit.thickness, fit.flat
     sliding = bool(pred.sliding and pred.joint_type == "prismatic") and sliding_agrees(
         initial.axis, obb, n, candidate.label, config.articulation.sliding_min_height_m)

@@ -83,3 +83,63 @@ def _hull_normals(q: np.ndarray, h, max_normals: int = 48) -> np.ndarray:  # noq
     key, inv = np.unique(np.round(n, 3), axis=0, return_inverse=True)
     total = np.bincount(inv.ravel(), weights=area, minlength=len(key))
     return key[np.argsort(-total, kind="stable")[:max_normals]]
+
+
+def _sorted_box(center: np.ndarray, axes: np.ndarray, ext: np.ndarray) -> OBB:
+    """An OBB from rows ``axes`` and ``ext``, sides sorted s1 >= s2 >= s3 in a right-handed frame."""
+    order = np.argsort(-ext, kind="stable")
+    R = axes[order].T.copy()
+    if np.linalg.det(R) < 0:
+        R[:, 2] *= -1
+    return OBB(center=tuple(center), axes=tuple(map(tuple, R.T)), extents=tuple(ext[order]))
+
+
+def surface_samples(triangles: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
+    """``n`` points spread uniformly over the area of ``triangles`` (m,3,3): the surface's own
+    distribution, whatever its tessellation."""
+    tri = np.asarray(triangles, float)
+    area = np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1) / 2
+    if not len(tri) or area.sum() <= 0:
+        return np.zeros((0, 3))
+    i = rng.choice(len(tri), n, p=area / area.sum())
+    s, r = np.sqrt(rng.random(n)), rng.random(n)
+    return tri[i, 0] * (1 - s)[:, None] + tri[i, 1] * (s * (1 - r))[:, None] + tri[i, 2] * (s * r)[:, None]
+
+
+def dense_span(x: np.ndarray, bin_m: float, min_density: float) -> tuple[float, float]:
+    """(lo, hi) of the samples ``x`` without the sparse ends: bins of ``bin_m`` holding fewer than
+    ``min_density`` x the median occupied bin's samples, counted from either end up to the first denser one."""
+    lo, hi = float(x.min()), float(x.max())
+    nb = max(1, int(np.ceil((hi - lo) / bin_m)))
+    h, edges = np.histogram(x, bins=nb, range=(lo, hi))
+    dense = np.flatnonzero(h >= min_density * np.median(h[h > 0]))
+    return float(edges[dense[0]]), float(edges[dense[-1] + 1])
+
+
+def trim_sparse_ends(obb: OBB, triangles: np.ndarray, min_density: float, min_trim_m: float, bin_m: float = 0.005,
+                     samples: int = 20000) -> OBB:
+    """``obb`` ending where the part's surface does along its two front sides (s1, s2).
+
+    A mask's edge on a scan mesh takes whole triangles, and one that bridges the seam to a neighbour (a
+    sliver from a flap's corner down to the drawer below it) stretches the box over that neighbour: the
+    hinge, the cavity and the front then lie partly in front of the other part. Along each front side, an
+    end whose surface is sparse (bins under ``min_density`` of the median, by area, not by vertex count) for
+    at least ``min_trim_m`` is cut off the box; the thickness axis is left alone (handles)."""
+    samples_xyz = surface_samples(triangles, samples, np.random.default_rng(0))  # fixed: the same box every run
+    if len(samples_xyz) < 100:
+        return obb
+    R, c, ext = obb.R, np.asarray(obb.center, float), np.asarray(obb.extents, float)
+    local = (samples_xyz - c) @ R
+    lo, hi = -ext / 2, ext / 2
+    changed = False
+    for k in (0, 1):
+        if ext[k] <= 2 * bin_m:
+            continue
+        a, b = dense_span(local[:, k], bin_m, min_density)
+        if a - lo[k] >= min_trim_m:
+            lo[k], changed = a, True
+        if hi[k] - b >= min_trim_m:
+            hi[k], changed = b, True
+    if not changed:
+        return obb
+    return _sorted_box(c + R @ ((lo + hi) / 2), R.T, hi - lo)

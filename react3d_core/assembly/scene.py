@@ -118,7 +118,7 @@ def assemble_scene(scene: SceneInput, mesh: TriMesh, parts: list[ArticulatedPart
     from ..scene_io.images import frame_depth
 
     out = Path(out_dir)
-    parts = remove_duplicates(list(parts), config.dedup, mesh.vertices)
+    parts = remove_duplicates(list(parts), config.dedup, mesh.vertices, mesh.faces)
     geo = _Geometry(mesh)
     bounds = mesh.bounds()
     frames = {f.frame_id: f for f in scene.frames}

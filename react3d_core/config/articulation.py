@@ -21,6 +21,12 @@ class ArticulationConfig(StageConfig):
                                                        "its top views show outside the predicted mask that covers the part "
                                                        "(more views outside than inside) go, when they are at least a tenth "
                                                        "of it (a drawer grown into the door below; beyond the paper).")
+    sparse_end_density: float = Field(0.1, ge=0, le=1, description="The part's box ends where its surface does: along each "
+                                                                   "front side, end bins (5 mm) holding less than this share of "
+                                                                   "the median bin's area are cut off when they span at least "
+                                                                   "sparse_end_min_m (a triangle bridging the seam to a "
+                                                                   "neighbour; 0: the box holds every vertex, as the paper).")
+    sparse_end_min_m: float = Field(0.02, gt=0, description="Shortest sparse end (m) that is cut off the part's box.")
     sliding_min_height_m: float = Field(0.3, ge=0, description="A 'sliding' prediction is kept only with its axis in the "
                                                               "front plane and on a front at least this tall (a lower "
                                                               "vertical front sliding sideways is a drawer front, which "

@@ -19,3 +19,5 @@ class DedupConfig(StageConfig):
     motion_angle_deg: float = Field(10.0, ge=0, le=90, description="Stage 5: same motion = same joint type with axes and front normals within this angle (degrees) ...")
     motion_hinge_m: float = Field(0.05, ge=0, description="... and, for hinges, axis lines within this distance (m): a piece's hinge is estimated from its own box, a few cm off its door's.")
     motion_slab_m: float = Field(0.03, ge=0, description="Stage 5: the footprint counts only within this distance (m) of the larger part's slab along its normal.")
+    enclosed_share: float = Field(0.8, ge=0, le=1, description="Stage 6: a kept part with this share of its front's footprint inside a larger kept part's box (in its slab) is enclosed by it ...")
+    enclosed_fill_max: float = Field(0.5, ge=0, le=1, description="... and when the larger part's surface (less what the two share) covers the enclosed footprint at most this share as densely as the rest of its box, the larger part is a mask merged around it: its box and faces are cut back to the side of the enclosed part that keeps most of its surface.")

@@ -19,6 +19,10 @@ sometimes splits a strip off a front (its bottom, seen from one view) that reach
 box, so stages 3 and 4 keep it; the same motion says it is the same door or drawer, while a door
 stacked on the same hinge line or a neighbouring drawer shares no footprint. Left in, it is a second
 body in the same place: it jams the part and blocks its front.
+Stage 6 (ours): an enclosing part — a mask merged around a smaller kept part in the same plane (a drawer's
+mask that took the drawers around a door, leaving the door's front a hole in it) — is cut back off it
+(``cut_enclosing``): its box spanned the other part's front, so each front's probe met the other's
+colliders and the hinge, cavity and carcass reached over its neighbour.
 """
 
 from __future__ import annotations
@@ -162,11 +166,113 @@ def grown_box(box: OBB, others: Sequence[OBB]) -> OBB:
     return OBB(center=tuple(center), axes=tuple(map(tuple, axes)), extents=tuple(ext))
 
 
-def remove_duplicates(parts: Sequence[T], cfg: DedupConfig, vertices: np.ndarray | None = None) -> list[T]:
+def _footprint_mask(points: np.ndarray, box: OBB, slab: float) -> np.ndarray:
+    """Points inside ``box``'s front footprint, within ``slab`` of its slab along its normal."""
+    local = (np.asarray(points, float) - np.asarray(box.center)) @ box.R
+    half = np.asarray(box.extents) / 2
+    return (np.abs(local[:, :2]) <= half[:2]).all(1) & (np.abs(local[:, 2]) <= half[2] + slab)
+
+
+@dataclasses.dataclass
+class EnclosedCut:
+    """How a merged part is cut back off the part it encloses: the faces it keeps and its new box."""
+
+    face_ids: np.ndarray
+    vertex_ids: np.ndarray
+    obb: OBB
+
+
+def enclosing_cut(big: OBB, big_faces: np.ndarray, small: OBB, vertices: np.ndarray, faces: np.ndarray,
+                  cfg: DedupConfig, samples: int = 4000) -> EnclosedCut | None:
+    """The cut of ``big`` (its scan faces ``big_faces``) back off ``small``'s footprint, or None when
+    ``big`` is no mask merged around it.
+
+    Merged around it: ``small``'s footprint lies in ``big``'s box (``enclosed_share``, in its slab) while
+    ``big``'s own surface covers that footprint at most ``enclosed_fill_max`` as densely as its box on
+    average (by area, whatever the tessellation): a hole in it. A smaller part over surface ``big`` does
+    cover is a piece of it or a duplicate (the earlier stages), or a dispute geometry alone cannot settle
+    (two masks over one front): left. The box then spans a front that is not its own: the hinge, the
+    cavity and the colliders reach over the other part. Of the four cuts along ``big``'s front sides at
+    the edges of ``small``'s footprint (``footprint_margin_m`` off), the one keeping most of that surface
+    is made: faces whose centroid lies past it go, and the box shrinks to what is kept (its normal and
+    thickness stay)."""
+    from ..articulation.obb import surface_samples
+
+    if footprint_share(small, big, cfg.footprint_margin_m, cfg.motion_slab_m) < cfg.enclosed_share:
+        return None
+    # of big's footprint, the share small's covers: small's area times the share of it inside big's box
+    area_share = float(np.prod(small.extents[:2]) * footprint_share(small, big, 0.0, np.inf) / max(np.prod(big.extents[:2]), 1e-12))
+    if area_share <= 0 or area_share >= 0.5:
+        return None  # small is no smaller in the plane: a duplicate, the earlier stages' business
+    own = np.asarray(big_faces, np.int64)
+    pts = surface_samples(vertices[faces[own]], samples, np.random.default_rng(0)) if len(own) else np.zeros((0, 3))
+    if len(pts) < 100:
+        return None
+    fill = float(_footprint_mask(pts, small, cfg.motion_slab_m).mean()) / area_share
+    if fill > cfg.enclosed_fill_max:
+        return None
+    R, c = big.R, np.asarray(big.center)
+    local = (pts - c) @ R
+    s_local = (small.corners() - c) @ R
+    lo_s, hi_s = s_local.min(0) - cfg.footprint_margin_m, s_local.max(0) + cfg.footprint_margin_m
+    options = [(int((local[:, k] <= lo_s[k]).sum()), k, -1) for k in (0, 1)] + [(int((local[:, k] >= hi_s[k]).sum()), k, 1) for k in (0, 1)]
+    kept_n, k, side = max(options)
+    if kept_n == 0:
+        return None
+    cen = (vertices[faces[own]].mean(1) - c) @ R
+    keep = own[(cen[:, k] <= lo_s[k]) if side < 0 else (cen[:, k] >= hi_s[k])]
+    if not len(keep):
+        return None
+    vids = np.unique(faces[keep].ravel())
+    vl = (vertices[vids] - c) @ R
+    half = np.asarray(big.extents, float) / 2
+    lo, hi = vl.min(0), vl.max(0)
+    lo[2], hi[2] = -half[2], half[2]
+    ext, axes = hi - lo, np.asarray(big.axes, float)
+    if ext[1] > ext[0]:  # extents in decreasing order: (u, v, n) -> (v, -u, n), still right-handed
+        axes, ext = np.array([axes[1], -axes[0], axes[2]]), ext[[1, 0, 2]]
+    box = OBB(center=tuple(c + R @ ((lo + hi) / 2)), axes=tuple(map(tuple, axes)), extents=tuple(ext))
+    return EnclosedCut(keep, vids, box)
+
+
+def cut_enclosing(parts: list[T], cfg: DedupConfig, vertices: np.ndarray, faces: np.ndarray) -> list[T]:
+    """Stage 6: each part merged around a smaller kept part in its plane (``enclosing_cut``) cut back off
+    it, larger parts first; a flat door's hinge is refined again on the new box (the paper's rule: the
+    edge nearer the predicted axis)."""
+    from ..articulation.refine import refine_revolute, slab_mid_and_thickness
+
+    out = list(parts)
+    area = [float(np.prod(p.obb.extents[:2])) for p in out]  # type: ignore[attr-defined]
+    cos = np.cos(np.radians(cfg.motion_angle_deg))
+    for i in sorted(range(len(out)), key=lambda i: -area[i]):
+        for j in range(len(out)):
+            big, small = out[i], out[j]
+            if j == i or area[j] >= area[i]:
+                continue
+            if float(np.asarray(big.front_normal) @ np.asarray(small.front_normal)) < cos:  # type: ignore[attr-defined]
+                continue
+            cut = enclosing_cut(big.obb, big.face_ids, small.obb, vertices, faces, cfg)  # type: ignore[attr-defined]
+            if cut is None:
+                continue
+            art = big.articulation  # type: ignore[attr-defined]
+            if art.joint_type == "revolute" and big.flat and not big.sliding:  # type: ignore[attr-defined]
+                mid, _ = slab_mid_and_thickness(vertices[cut.vertex_ids], np.asarray(cut.obb.center),
+                                                np.asarray(big.front_normal, float))  # type: ignore[attr-defined]
+                art = refine_revolute(big.initial, cut.obb, mid).model_copy(  # type: ignore[attr-defined]
+                    update={"lower": art.lower, "upper": art.upper, "limit_source": art.limit_source})
+            out[i] = dataclasses.replace(big, face_ids=cut.face_ids, vertex_ids=cut.vertex_ids, obb=cut.obb,  # type: ignore[type-var]
+                                         articulation=art)
+            area[i] = float(np.prod(cut.obb.extents[:2]))
+    return out
+
+
+def remove_duplicates(parts: Sequence[T], cfg: DedupConfig, vertices: np.ndarray | None = None,
+                      faces: np.ndarray | None = None) -> list[T]:
     """Parts (anything with ``vertex_ids``; with ``obb`` too for stage 4) without duplicates;
     ``vertices`` (the scan's) enable stage 4. Parts that are dataclasses with ``articulation``,
     ``front_normal``, ``sliding`` and ``face_ids`` (articulated parts) also go through stage 5: a kept
-    part takes its pieces' vertices and faces, and its box grows over their footprints."""
+    part takes its pieces' vertices and faces, and its box grows over their footprints; with the scan's
+    ``faces`` also through stage 6 (``cut_enclosing``)."""
     sets = [p.vertex_ids for p in parts]  # type: ignore[attr-defined]
     if vertices is None or not all(getattr(p, "obb", None) is not None for p in parts):
         return [parts[i] for i in dedup_indices(sets, cfg)]
@@ -187,4 +293,6 @@ def remove_duplicates(parts: Sequence[T], cfg: DedupConfig, vertices: np.ndarray
                 face_ids=np.unique(np.concatenate([np.asarray(q.face_ids, np.int64) for q in (p, *pieces)])),
                 obb=grown_box(p.obb, [q.obb for q in pieces]))
         out.append(p)
+    if faces is not None and all(hasattr(p, a) for p in out for a in ("initial", "flat")):
+        out = cut_enclosing(out, cfg, vertices, np.asarray(faces, np.int64))
     return out

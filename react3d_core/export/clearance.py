@@ -381,13 +381,19 @@ def box_conflicts(corners: np.ndarray, axes: np.ndarray, obstacles: Sequence[Obs
     return out
 
 
+BACK_TO_BACK_GAP_M = 0.1
+"""Fronts turned more than 135 degrees are back to back (the bisector parts them) only this far apart along
+it (m): a carcass's depth; nearer, they are neighbours in one plane with one normal estimated flipped."""
+
+
 def territory_plane(front_a: np.ndarray, normal_a: np.ndarray, front_b: np.ndarray, normal_b: np.ndarray,
                     parallel_deg: float = 5.0, axes: np.ndarray | None = None) -> tuple[np.ndarray, float]:
     """A plane between two neighbouring objects: (m, c) with A's front on the side m . x < c.
 
     Fronts turned against each other (a corner, or two fronts whose estimated normals differ) share
     the bisector of their planes, through the line where the planes meet, when it has each front on
-    its own side; otherwise (coplanar fronts side by side or stacked) the plane lies across one
+    its own side (fronts turned more than 135 degrees only when one lies wholly behind the other: back
+    to back, ``BACK_TO_BACK_GAP_M`` apart; side by side, one normal was estimated flipped); otherwise (coplanar fronts side by side or stacked) the plane lies across one
     direction in the fronts' plane, in the middle of the gap between them along it. ``axes``: candidate
     directions (the fronts' box axes); the one along which the fronts lie furthest apart is used (a
     tall door beside a drawer high up: across the row, not along the line between their centres).
@@ -401,9 +407,14 @@ def territory_plane(front_a: np.ndarray, normal_a: np.ndarray, front_b: np.ndarr
         c = float(na @ ca - nb @ cb) / float(np.linalg.norm(d))
         if m @ ca > c:
             m, c = -m, -c
-        if np.mean(front_a @ m < c) >= 0.9 and np.mean(front_b @ m > c) >= 0.9:
+        apart = np.mean(front_a @ m < c) >= 0.9 and np.mean(front_b @ m > c) >= 0.9
+        if apart and float(na @ nb) < -np.cos(np.radians(45.0)):
+            # turned more than 135 degrees: back to back (one behind the other along m), or one normal
+            # estimated flipped on coplanar fronts, whose bisector then runs through both
+            apart = float((front_b @ m).min()) - float((front_a @ m).max()) >= BACK_TO_BACK_GAP_M
+        if apart:
             return m, c
-    mean_n = na + nb
+    mean_n = na + (nb if float(na @ nb) >= 0 else -nb)  # a flipped normal still names the same plane
     mean_n = mean_n / np.linalg.norm(mean_n) if np.linalg.norm(mean_n) > 1e-9 else na
     if axes is not None:
         cand = np.asarray(axes, float).reshape(-1, 3)

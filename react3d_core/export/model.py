@@ -141,12 +141,14 @@ def shift_walls(base: list[ConvexPiece], m: np.ndarray, c: float, max_shift: flo
     their far face lies on it. Two estimated carcasses stacked or side by side interleave (a cupboard's
     floor a few cm below the drawer box's roof beneath it): cutting each to its side drops both of those
     walls and leaves one open space through both cavities; moved, each keeps its own wall at the
-    boundary. Walls the plane crosses are left to the cut."""
+    boundary. Walls the plane crosses are left to the cut, and so are walls deeper along ``m`` than
+    ``max_shift``: a plane at an angle to a wall (the bisector of two fronts estimated at an angle) would
+    move it by its whole depth along the plane's normal, into the middle of its own cavity."""
     out = []
     for p in base:
         s = p.vertices @ m
         lo = float(s.min())
-        if c < lo <= c + max_shift:
+        if c < lo <= c + max_shift and float(s.max()) - lo <= max_shift:
             shift = float(s.max()) - c
             p = ConvexPiece(p.vertices - shift * m, p.faces, p.source,
                             None if p.box is None else np.concatenate([p.box[:3] - shift * m, p.box[3:]]))

@@ -195,6 +195,28 @@ def test_a_box_cut_along_its_own_axis_stays_a_box() -> None:
     assert out.box is None and gap(out.vertices, piece_axes(out), ob)[0] >= 0.005 - 1e-9
 
 
+def test_territory_plane_of_side_by_side_fronts_with_one_normal_flipped_lies_across_the_row() -> None:
+    # two doors side by side in the plane y = 0.5 (x in [0, 0.5] and [0.5015, 1], z in [0, 0.8]), the door
+    # fronts' own vertices a few mm deep (front and back face); the second door's normal estimated flipped.
+    # The bisector of the two normals is a plane y = const through both fronts (it cut a door's colliders
+    # away); the plane must be x = 0.50075, across the row
+    a = np.array([[x, y, z] for x in (0.0, 0.5) for y in (0.5, 0.502, 0.503) for z in (0.0, 0.8)])
+    b = a + np.array([0.5015, -0.004, 0.0])
+    for tilt in (0.0, 5.0):  # exactly opposite, or 5 degrees further off
+        t = np.radians(tilt)
+        m, c = territory_plane(a, np.array([0, 1.0, 0]), b, np.array([np.sin(t), -np.cos(t), 0]), axes=np.eye(3))
+        assert m[0] > np.cos(np.radians(3.0))  # across the row (2.5 degrees off x with the 5-degree tilt)
+        assert (a @ m).max() <= c <= (b @ m).min()
+        if tilt == 0.0:
+            np.testing.assert_allclose(m, [1, 0, 0], atol=1e-12)
+            assert c == pytest.approx(0.50075)
+    # back to back (carcasses meeting behind them): the bisector, y = 0.3, between them
+    back = np.array([[x, 0.6, z] for x in (0.0, 0.5) for z in (0.0, 0.8)])
+    m, c = territory_plane(a[a[:, 1] == 0.5] - [0, 0.5, 0], np.array([0, 1.0, 0]), back, np.array([0, -1.0, 0]), axes=np.eye(3))
+    np.testing.assert_allclose(m, [0, 1, 0], atol=1e-12)
+    assert c == pytest.approx(0.3)
+
+
 def test_territory_plane_lies_across_the_axis_that_separates_the_fronts() -> None:
     # a tall door (x in [0, 0.5], z in [0, 0.8]) beside a short drawer high up (x in [0.5015, 1], z in [0.6, 0.8]):
     # the line between their centres is 32 degrees off the row; the plane must be x = 0.50075
@@ -240,6 +262,24 @@ def test_interleaved_carcass_walls_are_moved_to_their_side_not_dropped():
     assert out[1] is far and out[2] is side
     kept, _ = keep_side(out, m, c)
     assert len(kept) == 2  # the moved floor and the cut side; the far plate is dropped
+
+
+def test_a_wall_at_an_angle_to_the_plane_is_not_moved_by_its_depth():
+    from react3d_core.export.model import shift_walls
+
+    # a cupboard's roof 0.74 m deep (x), z 0.346..0.355, under a plane tilted 8 degrees (the bisector with a
+    # drawer front estimated 16 degrees off level): the roof lies wholly past it, but 10 cm deep along m.
+    # Moved until its far face met the plane it would sit 12 cm down, in the middle of its own cavity.
+    t = np.radians(8.0)
+    m = np.array([-np.sin(t), 0.0, -np.cos(t)])  # the cupboard keeps m . x <= c (below the plane)
+    roof = cube([4.081, 4.05, 0.346], [4.825, 4.38, 0.355])
+    c = float((roof.vertices @ m).min()) - 0.005  # its nearest corner 5 mm past the plane
+    (out,) = shift_walls([roof], m, c)
+    assert out is roof
+    thin = cube([4.081, 4.05, 0.346], [4.125, 4.38, 0.355])  # a wall thin along m is still moved onto the plane
+    c = float((thin.vertices @ m).min()) - 0.005
+    (moved,) = shift_walls([thin], m, c)
+    assert float((moved.vertices @ m).max()) == pytest.approx(c)
 
 
 def test_fronts_apart_only_when_the_plane_parts_them():
