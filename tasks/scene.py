@@ -54,7 +54,8 @@ class CachedSelections:
 @lru_cache(maxsize=4)
 def _loaded(scene_path: str, frames_json: str) -> LoadedScene:
     return load(scene_path, FrameSelectionConfig.model_validate(json.loads(frames_json)),
-                raster_for=lambda mesh_path: rasterizer(str(mesh_path)), memo=CachedSelections())
+                raster_for=lambda mesh_path: rasterizer(str(mesh_path)), memo=CachedSelections(),
+                cache_dir=cache_root())  # completed scans live beside the rest of the worker's store
 
 
 def loaded_scene(scene_path: str, config: dict[str, Any]) -> LoadedScene:
