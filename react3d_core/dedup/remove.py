@@ -8,6 +8,9 @@ is O(n * k). Overlaps come from one sparse incidence product (``geometry.overlap
 Stage 3 (ours): a fragment — a part with >= tau_contained of its vertices inside one larger kept part —
 is removed. Distinct physical parts share at most boundary vertices, so such a part is a piece of the
 larger one (a frame or a panel of a frame-and-panel door that fusion also proposed on its own).
+Stage 3 also removes a bridge: a part with ``bridge_share`` of its vertices inside other kept parts, split
+over at least two of them — a mask that spans the seam between two fronts whose own masks are kept (the
+halves of a double door). Its box spans both fronts, so each front's probe meets it.
 Stage 4 (ours): a sliver — a part with at most ``fragment_share`` of a larger kept part's vertices and
 >= tau_contained of its points inside that part's box (grown by ``footprint_margin_m``) — is removed.
 Fusion sometimes splits a corner off a front (seen occluded in some views); the corner's vertices are
@@ -18,11 +21,15 @@ its front's footprint inside that part's front — is merged into it (vertices, 
 sometimes splits a strip off a front (its bottom, seen from one view) that reaches past the larger part's
 box, so stages 3 and 4 keep it; the same motion says it is the same door or drawer, while a door
 stacked on the same hinge line or a neighbouring drawer shares no footprint. Left in, it is a second
-body in the same place: it jams the part and blocks its front.
+body in the same place: it jams the part and blocks its front. A scrap — a part whose front's shorter side
+is under ``scrap_max_m``, smaller than any front — is merged into the larger kept part whose footprint
+(grown by ``scrap_reach_m``) holds ``tau_contained`` of its points, whatever its motion: the box of a few
+centimetres of surface gives no reliable normal (a corner the larger part's masks missed came out 14° off).
 Stage 6 (ours): an enclosing part — a mask merged around a smaller kept part in the same plane (a drawer's
 mask that took the drawers around a door, leaving the door's front a hole in it) — is cut back off it
 (``cut_enclosing``): its box spanned the other part's front, so each front's probe met the other's
-colliders and the hinge, cavity and carcass reached over its neighbour.
+colliders and the hinge, cavity and carcass reached over its neighbour. A part cut back goes through
+stages 1-5 again: what is left of it can lie over a front whose own mask is kept (a duplicate).
 """
 
 from __future__ import annotations
@@ -120,6 +127,14 @@ def dedup_plan(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence[np
         inside = alive & (size > size[i]) & (contained[i] >= cfg.tau_contained)
         if alive[i] and inside.any():
             alive[i] = False
+    for i in order:  # stage 3, bridges: larger first, so a bridge goes before the fronts it spans are judged
+        holders = np.flatnonzero(alive & (contained[i] >= cfg.tau_low))
+        holders = holders[holders != i]
+        if not alive[i] or len(holders) < 2 or (boxes is not None and min(boxes[i].extents[:2]) < cfg.scrap_max_m):
+            continue  # a scrap shares its few vertices with every neighbour: stage 5 merges it instead
+        union = np.unique(np.concatenate([sets_u[j] for j in holders]))
+        if np.isin(sets_u[i], union, assume_unique=True).mean() >= cfg.bridge_share:
+            alive[i] = False
     if points is not None and boxes is not None:
         for i in order[::-1]:  # stage 4, smaller first, against larger kept parts
             if not alive[i] or not len(points[i]):
@@ -135,6 +150,17 @@ def dedup_plan(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence[np
                 continue
             art_i, n_i, slide_i = motions[i]
             best, into = cfg.motion_share, -1
+            scrap = points is not None and len(points[i]) > 0 and min(boxes[i].extents[:2]) < cfg.scrap_max_m
+            if scrap:  # into the part that reaches most of it, shares most of its vertices (its surface), is nearest
+                fits = [(float(_footprint_mask(points[i], boxes[j], cfg.motion_slab_m, cfg.scrap_reach_m).mean()),
+                         float(inter[i, j]), -_outside_m(points[i], boxes[j]), int(j))
+                        for j in np.flatnonzero(alive & (size > size[i]))]
+                fits = [t for t in fits if t[0] >= cfg.tau_contained]
+                if fits:
+                    into = max(fits)[-1]
+                    alive[i] = False
+                    merged.setdefault(into, []).append(int(i))
+                continue
             for j in np.flatnonzero(alive & (size > size[i])):
                 art_j, n_j, slide_j = motions[j]
                 if slide_i != slide_j or not same_motion(art_i, art_j, n_i, n_j, cfg):
@@ -166,11 +192,18 @@ def grown_box(box: OBB, others: Sequence[OBB]) -> OBB:
     return OBB(center=tuple(center), axes=tuple(map(tuple, axes)), extents=tuple(ext))
 
 
-def _footprint_mask(points: np.ndarray, box: OBB, slab: float) -> np.ndarray:
-    """Points inside ``box``'s front footprint, within ``slab`` of its slab along its normal."""
+def _outside_m(points: np.ndarray, box: OBB) -> float:
+    """Mean distance (m) in ``box``'s front plane from ``points`` to its footprint (0 inside)."""
+    local = (np.asarray(points, float) - np.asarray(box.center)) @ box.R
+    return float(np.linalg.norm(np.maximum(np.abs(local[:, :2]) - np.asarray(box.extents[:2]) / 2, 0.0), axis=1).mean())
+
+
+def _footprint_mask(points: np.ndarray, box: OBB, slab: float, margin: float = 0.0) -> np.ndarray:
+    """Points inside ``box``'s front footprint (grown in its plane by ``margin``), within ``slab`` of its
+    slab along its normal."""
     local = (np.asarray(points, float) - np.asarray(box.center)) @ box.R
     half = np.asarray(box.extents) / 2
-    return (np.abs(local[:, :2]) <= half[:2]).all(1) & (np.abs(local[:, 2]) <= half[2] + slab)
+    return (np.abs(local[:, :2]) <= half[:2] + margin).all(1) & (np.abs(local[:, 2]) <= half[2] + slab)
 
 
 @dataclasses.dataclass
@@ -276,6 +309,23 @@ def remove_duplicates(parts: Sequence[T], cfg: DedupConfig, vertices: np.ndarray
     sets = [p.vertex_ids for p in parts]  # type: ignore[attr-defined]
     if vertices is None or not all(getattr(p, "obb", None) is not None for p in parts):
         return [parts[i] for i in dedup_indices(sets, cfg)]
+    out = _merge_pass(parts, cfg, vertices)
+    if faces is None or not all(hasattr(p, a) for p in out for a in ("initial", "flat")):
+        return out
+    faces = np.asarray(faces, np.int64)
+    for _ in range(3):
+        cut = cut_enclosing(out, cfg, vertices, faces)
+        if all(c is o for c, o in zip(cut, out)):
+            break
+        # a mask that took a front and the fronts beside it, cut back off those, can be left over the
+        # front it took, where that front's own mask is kept too: the cut parts go through stages 1-5 again
+        out = _merge_pass(cut, cfg, vertices)
+    return out
+
+
+def _merge_pass(parts: Sequence[T], cfg: DedupConfig, vertices: np.ndarray) -> list[T]:
+    """Stages 1-5 over ``parts`` (with boxes), pieces merged into the parts that keep them."""
+    sets = [p.vertex_ids for p in parts]  # type: ignore[attr-defined]
     pts = [vertices[np.asarray(v, np.int64)] for v in sets]
     boxes = [p.obb for p in parts]  # type: ignore[attr-defined]
     movable = all(dataclasses.is_dataclass(p) and all(hasattr(p, a) for a in
@@ -293,6 +343,4 @@ def remove_duplicates(parts: Sequence[T], cfg: DedupConfig, vertices: np.ndarray
                 face_ids=np.unique(np.concatenate([np.asarray(q.face_ids, np.int64) for q in (p, *pieces)])),
                 obb=grown_box(p.obb, [q.obb for q in pieces]))
         out.append(p)
-    if faces is not None and all(hasattr(p, a) for p in out for a in ("initial", "flat")):
-        out = cut_enclosing(out, cfg, vertices, np.asarray(faces, np.int64))
     return out
