@@ -39,6 +39,7 @@ class Handle:
     box: tuple[int, int, int, int]
     horizontal: bool
     pixels: np.ndarray  # (N, 2) cols, rows
+    knob: bool = False  # a compact knob, not a bar: it has no direction
 
     @property
     def center(self) -> tuple[float, float]:
@@ -144,8 +145,10 @@ def off_threshold(diff: np.ndarray, valid: np.ndarray, cfg: HeuristicConfig) -> 
 
 
 def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff: np.ndarray | None = None,
-                 protrusion: np.ndarray | None = None, outline: np.ndarray | None = None) -> list[Handle]:
-    """Compact elongated blobs whose colour differs from the local background (see module docstring).
+                 protrusion: np.ndarray | None = None, outline: np.ndarray | None = None,
+                 knobs: bool = True) -> list[Handle]:
+    """Compact elongated blobs whose colour differs from the local background (see module docstring),
+    and with ``knobs`` and ``handles.knobs`` compact round ones (``_is_knob``).
     Colour blobs keep ``handles.outline_margin`` inside ``coverage`` (colour beside a scanning shadow is
     misregistered); a handle must lie inside ``outline`` (coverage with handle shadows filled; default
     ``coverage``)."""
@@ -178,9 +181,10 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     for j in range(1, n):
         x, y, w, h, area = stats[j]
         long_, short = max(w, h) * o.res, min(w, h) * o.res
-        if not (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]):
-            continue
-        if max(w, h) < p.aspect * min(w, h) or area < p.min_fill * w * h:
+        bar = (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]
+               and max(w, h) >= p.aspect * min(w, h) and area >= p.min_fill * w * h)
+        knob = not bar and knobs and p.knobs and _is_knob(w, h, area, o.res, p)
+        if not (bar or knob):
             continue
         if p.seam_share > 0:
             seams = _long_seams(o, cfg, L) if seams is None else seams
@@ -195,8 +199,15 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
         if p.side_cover > 0 and min(_side_cover(ref, (x, y, w, h), pad)) < p.side_cover:
             continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
-        out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1)))
+        out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
     return out
+
+
+def _is_knob(w: int, h: int, area: int, res: float, p: HandleConfig) -> bool:
+    """A blob of ``w`` x ``h`` px holding ``area`` px is a knob: both sides within ``knob_size`` (m), at most
+    ``knob_aspect`` long for its width, filling ``knob_min_fill`` of its box (a disc fills pi / 4)."""
+    return bool(p.knob_size[0] <= min(w, h) * res and max(w, h) * res <= p.knob_size[1]
+                and max(w, h) <= p.knob_aspect * min(w, h) and area >= p.knob_min_fill * w * h)
 
 
 def _long_seams(o: Orthophoto, cfg: HeuristicConfig, length_px: int) -> np.ndarray:

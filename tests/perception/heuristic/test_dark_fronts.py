@@ -1,0 +1,89 @@
+"""Where the image path loses dark fronts (the depth sensor missed them; the scan is completed with a slab
+coloured from the views): the mechanisms traced on the dark tuning scenes, each on a constructed
+orthophoto — knob handles, which have no bar's shape."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
+from react3d_core.perception.heuristic.front_cells import _is_knob, find_handles, split_cells
+from react3d_core.perception.heuristic.fronts import Front, _joint
+from react3d_core.perception.heuristic.orthophoto import Orthophoto
+from react3d_core.perception.heuristic.planes import Plane
+
+
+def _ortho(img: np.ndarray, res: float = 0.004) -> Orthophoto:
+    """An orthophoto of plane y = 0 facing -y (u along x), every pixel seen by 5 views."""
+    h, w = img.shape[:2]
+    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
+                  (0.0, w * res), (0.0, h * res), w * h * res * res)
+    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+
+
+def _disc(img: np.ndarray, r: int, c: int, radius: int, value: float) -> None:
+    rr, cc = np.mgrid[:img.shape[0], :img.shape[1]]
+    img[(rr - r) ** 2 + (cc - c) ** 2 <= radius ** 2] = value
+
+
+def test_knob_shape() -> None:
+    """At 4 mm: a 12 x 12 px blob (4.8 cm) filling 113 px (a disc of radius 6: 0.78 of its box) is a knob;
+    the same box filled 0.5 (speckle on a dark front) is not, nor a 20 x 20 px blob (8 cm: a socket), a
+    5 x 5 px one (2 cm) or a 12 x 24 px one (aspect 2 > 1.6)."""
+    p = HeuristicConfig().handles
+    assert _is_knob(12, 12, 113, 0.004, p)
+    assert not _is_knob(12, 12, 72, 0.004, p)
+    assert not _is_knob(20, 20, 314, 0.004, p)
+    assert not _is_knob(5, 5, 20, 0.004, p)
+    assert not _is_knob(12, 24, 230, 0.004, p)
+
+
+def test_knobs_split_stacked_dark_drawers() -> None:
+    """A 0.44 x 0.75 m dark column (110 x 188 px, 0.15 of the plane's exposure, a little noise, no visible
+    seam) holding three drawers, each with a pale knob 5 cm across (disc radius 6 px) in its middle at rows
+    31, 94, 157. A knob is no bar (10-50 cm long, aspect >= 2.2), so without knobs the column has no
+    handle and stays one cell; with them it is cut between each pair of knobs, into three cells."""
+    rng = np.random.default_rng(7)
+    img = np.full((188, 110, 3), 0.15, np.float32) + rng.normal(0, 0.003, (188, 110, 3)).astype(np.float32)
+    for r in (31, 94, 157):
+        _disc(img, r, 55, 6, 0.9)
+    o = _ortho(img)
+    cov = np.ones(img.shape[:2], bool)
+    off = HeuristicConfig(handles={"knobs": False})
+    on = HeuristicConfig()
+    assert find_handles(o, cov, off) == []
+    knobs = find_handles(o, cov, on)
+    assert len(knobs) == 3 and all(k.knob for k in knobs)
+    assert len(split_cells(o, cov, find_handles(o, cov, off), off)) == 1
+    cells = split_cells(o, cov, knobs, on)
+    assert len(cells) == 3
+    assert [len(c.handles) for c in cells] == [1, 1, 1]
+    cuts = sorted(c.r0 for c in cells)[1:]
+    assert 40 <= cuts[0] <= 85 and 103 <= cuts[1] <= 148
+
+
+def _front(w: float, h: float) -> Front:
+    return Front(facet=-1, handle_facets=[], center=np.array([w / 2, 0.0, 0.5 + h / 2]), n_out=np.array([0.0, -1.0, 0.0]),
+                 u=np.array([1.0, 0.0, 0.0]), extent_u=(0.0, w), extent_v=(0.5, 0.5 + h), faces=np.zeros(0, np.int64))
+
+
+def _knob_points(u: float, v: float, d: float = 0.04) -> np.ndarray:
+    """Points of a knob d across, centred at (u, z=v) on the plane y = 0: a square grid (extent d both ways)."""
+    g = np.linspace(-d / 2, d / 2, 5)
+    uu, vv = np.meshgrid(g + u, g + v)
+    return np.stack([uu.ravel(), np.zeros(uu.size), vv.ravel()], 1)
+
+
+def test_knob_types_the_joint_by_where_it_sits() -> None:
+    """A knob has no direction (its extent is the same both ways), so ``ptp(u) >= ptp(v)`` read it as a
+    horizontal bar and a 0.45 x 0.7 m door with a knob at its right edge became a drop door. Read by its
+    place: at the edge (0.19 m from the centre line, over 0.25 x 0.45) it is a door hinged on the far (left)
+    side; centred on a 0.5 x 0.2 m front it is a drawer. With ``knob_centre`` 0.5 every knob reads as
+    a horizontal bar, as before the rule."""
+    r = FrontRulesConfig()
+    door = _front(0.45, 0.7)
+    kind, art = _joint(door, _knob_points(0.415, 0.85), [], r)
+    assert kind == "door" and abs(art.axis[2]) == 1.0 and art.origin[0] == 0.0
+    assert _joint(door, _knob_points(0.415, 0.85), [], FrontRulesConfig(knob_centre=0.5))[0] == "drop"
+    drawer = _front(0.5, 0.2)
+    assert _joint(drawer, _knob_points(0.25, 0.6), [], r)[0] == "drawer"
