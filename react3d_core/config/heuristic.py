@@ -307,6 +307,7 @@ class CellConfig(StageConfig):
     min_side: float = Field(0.1, ge=0, description="No cell narrower than this (m).")
     max_split_depth: int = Field(6, ge=0, description="Guillotine split recursion depth.")
     outline_step: float = Field(0.5, ge=0, description="Where the covered extent across a line jumps by this share of the cell (an L-shaped outline: a tall unit beside a base run), the cell is cut there first; 0: off.")
+    edge_strip: float = Field(0.2, ge=0, description="Inside a cell holding handles a horizontal cut must leave a handle on both sides, except that a handle-less strip at most this tall (m) along the cell's top or bottom edge is cut off and is no front: a plinth, a worktop's or a carcass top's edge, which a slab over a dark unit takes in (0: such a cut is refused and the strip stays in the front).")
     min_seen: float = Field(0.55, ge=0, le=1, description="Share of a cell the plane's faces must cover.")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
     handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")

@@ -87,3 +87,29 @@ def test_knob_types_the_joint_by_where_it_sits() -> None:
     assert _joint(door, _knob_points(0.415, 0.85), [], FrontRulesConfig(knob_centre=0.5))[0] == "drop"
     drawer = _front(0.5, 0.2)
     assert _joint(drawer, _knob_points(0.25, 0.6), [], r)[0] == "drawer"
+
+
+def test_plinth_strip_comes_off_a_handled_front() -> None:
+    """A dark drawer front 0.5 m wide (125 px, 0.15 of the exposure) with a pale bar handle (0.18 m x 2 cm,
+    rows 45-49), standing on a 0.1 m plinth strip of another shade (rows 100-124, 0.4), as a slab over a
+    dark unit takes it in. The colour step at row 100 is the cell's strongest line, but a horizontal cut
+    in a cell holding a handle must leave a handle on both sides: without the strip rule
+    (``cells.edge_strip`` 0) the cut is refused and the front keeps the plinth (125 rows); with it the
+    handle-less strip along the bottom edge (25 rows = 0.1 m <= 0.2 m) is cut off and dropped."""
+    rng = np.random.default_rng(11)
+    img = np.full((125, 125, 3), 0.15, np.float32) + rng.normal(0, 0.003, (125, 125, 3)).astype(np.float32)
+    img[100:] = 0.4 + rng.normal(0, 0.003, (25, 125, 3)).astype(np.float32)
+    img[45:50, 40:85] = 0.9
+    o = _ortho(img)
+    cov = np.ones(img.shape[:2], bool)
+    off = HeuristicConfig(cells={"edge_strip": 0.0})
+    on = HeuristicConfig()
+    handles = find_handles(o, cov, on)
+    assert len(handles) == 1 and not handles[0].knob
+    kept = split_cells(o, cov, handles, off)
+    assert [(c.r0, c.r1) for c in kept] == [(0, 125)]
+    trimmed = split_cells(o, cov, handles, on)
+    assert len(trimmed) == 1 and trimmed[0].r0 == 0 and 98 <= trimmed[0].r1 <= 101
+    assert len(trimmed[0].handles) == 1
+    # a handle-less part taller than edge_strip is not a strip: the cut is refused as before
+    assert [(c.r0, c.r1) for c in split_cells(o, cov, handles, HeuristicConfig(cells={"edge_strip": 0.08}))] == [(0, 125)]
