@@ -5,6 +5,7 @@ orthophoto — knob handles, which have no bar's shape."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
 from react3d_core.perception.heuristic.front_cells import _is_knob, find_handles, split_cells
@@ -113,3 +114,25 @@ def test_plinth_strip_comes_off_a_handled_front() -> None:
     assert len(trimmed[0].handles) == 1
     # a handle-less part taller than edge_strip is not a strip: the cut is refused as before
     assert [(c.r0, c.r1) for c in split_cells(o, cov, handles, HeuristicConfig(cells={"edge_strip": 0.08}))] == [(0, 125)]
+
+
+def test_bench_dark_fronts_box_and_f1_by_hand() -> None:
+    """benchmarks/bench_dark_fronts.py scores a front as a 2 cm box on its rectangle: a 0.4 x 0.2 m front
+    (u along x) against a part box 0.4 x 0.3 m sharing its left, right and bottom edges has IoU
+    0.08 / 0.12 = 2/3 (front_box_iou, the evaluator's); a tall front's box has z as its longest side. F1 is
+    2 TP / (predictions + parts): 3 matches of 4 predictions for 5 parts -> 6 / 9."""
+    from benchmarks.bench_dark_fronts import f1, front_box
+    from react3d_core.data.parts import OBB
+    from react3d_core.metrics.scene_metrics import front_box_iou
+
+    wide = Front(facet=-1, handle_facets=[], center=np.array([0.2, 0.0, 0.6]), n_out=np.array([0.0, -1.0, 0.0]),
+                 u=np.array([1.0, 0.0, 0.0]), extent_u=(0.0, 0.4), extent_v=(0.5, 0.7), faces=np.zeros(0, np.int64))
+    part = OBB(center=(0.2, 0.0, 0.65), axes=((1.0, 0, 0), (0, 0, 1.0), (0, -1.0, 0)), extents=(0.4, 0.3, 0.02))
+    box = front_box(wide)
+    assert box.extents == (0.4, pytest.approx(0.2), 0.02) and box.axes[0] == (1.0, 0.0, 0.0)
+    assert front_box_iou(box, part) == pytest.approx(2 / 3, abs=1e-6)
+    tall = _front(0.4, 0.7)
+    assert front_box(tall).axes[0] == (0.0, 0.0, 1.0) and front_box(tall).extents[0] == pytest.approx(0.7)
+    assert f1(3, 4, 5) == pytest.approx(6 / 9)
+    assert f1(0, 0, 0) == 0.0
+
