@@ -146,9 +146,9 @@ def off_threshold(diff: np.ndarray, valid: np.ndarray, cfg: HeuristicConfig) -> 
 
 def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff: np.ndarray | None = None,
                  protrusion: np.ndarray | None = None, outline: np.ndarray | None = None,
-                 knobs: bool = True) -> list[Handle]:
+                 bars_only: bool = False) -> list[Handle]:
     """Compact elongated blobs whose colour differs from the local background (see module docstring),
-    and with ``knobs`` and ``handles.knobs`` compact round ones (``_is_knob``).
+    and with ``handles.knobs`` compact round ones (``_is_knob``) unless ``bars_only``.
     Colour blobs keep ``handles.outline_margin`` inside ``coverage`` (colour beside a scanning shadow is
     misregistered); a handle must lie inside ``outline`` (coverage with handle shadows filled; default
     ``coverage``)."""
@@ -183,7 +183,7 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
         long_, short = max(w, h) * o.res, min(w, h) * o.res
         bar = (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]
                and max(w, h) >= p.aspect * min(w, h) and area >= p.min_fill * w * h)
-        knob = not bar and knobs and p.knobs and _is_knob(w, h, area, o.res, p)
+        knob = not bar and not bars_only and p.knobs and _is_knob(w, h, area, o.res, p)
         if not (bar or knob):
             continue
         if p.seam_share > 0:
