@@ -62,6 +62,8 @@ class FrontRulesConfig(StageConfig):
     flap_max_deg: float = Field(90.0, gt=0, description="A flap's or drop door's guessed opening (deg).")
     door_max_deg: float = Field(100.0, gt=0, description="A side-hinged door's guessed opening (deg).")
     neighbour_gap: float = Field(0.03, ge=0, description="Coplanar fronts closer than this (m) are neighbours (door pairs, drawer stacks).")
+    knob_max_aspect: float = Field(2.0, ge=1, description="A handle whose extent one way is less than this times the other is a knob, which has no direction: ...")
+    knob_centre: float = Field(0.25, ge=0, le=0.5, description="... within this share of the front's width from its vertical centre line it is read as a horizontal bar (a drawer's or a flap's knob), farther out as a vertical one (a door's, at its opening edge).")
     row_overlap: float = Field(0.01, ge=0, description="Fronts in a row (doors_in_rows) may overlap side by side by this much (m) ...")
     row_min_height_share: float = Field(0.7, ge=0, le=1, description="... and share at least this part of the smaller one's height.")
     row_door_min_h: float = Field(0.5, ge=0, description="A front with a horizontal bar at least this tall (m) beside a drop-door guess makes a row of cabinet doors, not an oven.")
@@ -292,6 +294,10 @@ class HandleConfig(StageConfig):
     bar_close_px: int = Field(5, ge=1, description="A mesh handle's splatted face centroids are closed with a kernel of this many px (they sit half a face inside its outline).")
     shadows: bool = Field(True, description="On a front without a seen handle, an enclosed horizontal unseen hole of handle size above the cameras' median height is the handle's scanning shadow (a bar seen from below hides the front behind it in every view); it types the joint (wall-cabinet flaps), it does not cut cells.")
     shadow_min_thick: float = Field(0.03, ge=0, description="A handle's scanning shadow is at least this tall (m).")
+    knobs: bool = Field(True, description="Knobs are handles too: a compact blob (knob_size both ways, at most knob_aspect long for its width, filling knob_min_fill of its box) found like a bar. A sideboard or chest with knobs showed no bar, so its stacked drawers had no handle to split them apart, and a knob's side types a door's hinge (on a low front a centred one marks a drawer).")
+    knob_size: tuple[float, float] = Field((0.025, 0.065), description="Both sides of a knob's blob (min, max; m): larger is a socket or a switch, smaller is noise.")
+    knob_aspect: float = Field(1.6, ge=1, description="A knob's long side is at most this times its short side.")
+    knob_min_fill: float = Field(0.7, ge=0, le=1, description="A knob's blob fills at least this share of its box (a round knob fills ~0.79; speckle on a dark front fills 0.2-0.6).")
     seam_share: float = Field(0.9, ge=0, le=1, description="A blob with at least this share of its pixels on straight seam evidence longer than any handle is a piece of a seam, not a handle (a fused seam is 3-5 px wide; where only part of it passes the contrast it is a bar-sized blob). At 0.5 a RedKitchen bar beside a door seam went too (every 4th frame: 6 / 4 -> 5 / 5). 0: off.")
 
 
@@ -301,6 +307,7 @@ class CellConfig(StageConfig):
     min_side: float = Field(0.1, ge=0, description="No cell narrower than this (m).")
     max_split_depth: int = Field(6, ge=0, description="Guillotine split recursion depth.")
     outline_step: float = Field(0.5, ge=0, description="Where the covered extent across a line jumps by this share of the cell (an L-shaped outline: a tall unit beside a base run), the cell is cut there first; 0: off.")
+    edge_strip: float = Field(0.2, ge=0, description="Inside a cell holding handles a horizontal cut must leave a handle on both sides, except that a handle-less strip at most this tall (m) along the cell's top or bottom edge is cut off and is no front: a plinth, a worktop's or a carcass top's edge, which a slab over a dark unit takes in (0: such a cut is refused and the strip stays in the front).")
     min_seen: float = Field(0.55, ge=0, le=1, description="Share of a cell the plane's faces must cover.")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
     handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")

@@ -22,6 +22,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 16: a straight seam dips in every 0.3 m piece of its length (seams.piece_*), the cut between stacked
 #     handles is sought between their centres, a front's own handles are no clutter in the mesh-front veto,
 #     a blob lying on a long straight seam is no handle (handles.seam_share)
-HEURISTIC_VERSION = "16"
+# 17: knobs are handles (handles.knobs: compact round blobs), and a knob types its front by where it sits
+#     (fronts.knob_*: centred is a drawer's or a flap's, off-centre a door's opening edge); a handle-less strip
+#     along a handled cell's top or bottom edge is cut off (cells.edge_strip: plinths, worktop edges)
+HEURISTIC_VERSION = "17"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

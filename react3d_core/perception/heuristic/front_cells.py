@@ -39,6 +39,7 @@ class Handle:
     box: tuple[int, int, int, int]
     horizontal: bool
     pixels: np.ndarray  # (N, 2) cols, rows
+    knob: bool = False  # a compact knob, not a bar: it has no direction
 
     @property
     def center(self) -> tuple[float, float]:
@@ -144,8 +145,10 @@ def off_threshold(diff: np.ndarray, valid: np.ndarray, cfg: HeuristicConfig) -> 
 
 
 def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff: np.ndarray | None = None,
-                 protrusion: np.ndarray | None = None, outline: np.ndarray | None = None) -> list[Handle]:
-    """Compact elongated blobs whose colour differs from the local background (see module docstring).
+                 protrusion: np.ndarray | None = None, outline: np.ndarray | None = None,
+                 bars_only: bool = False) -> list[Handle]:
+    """Compact elongated blobs whose colour differs from the local background (see module docstring),
+    and with ``handles.knobs`` compact round ones (``_is_knob``) unless ``bars_only``.
     Colour blobs keep ``handles.outline_margin`` inside ``coverage`` (colour beside a scanning shadow is
     misregistered); a handle must lie inside ``outline`` (coverage with handle shadows filled; default
     ``coverage``)."""
@@ -178,9 +181,10 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     for j in range(1, n):
         x, y, w, h, area = stats[j]
         long_, short = max(w, h) * o.res, min(w, h) * o.res
-        if not (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]):
-            continue
-        if max(w, h) < p.aspect * min(w, h) or area < p.min_fill * w * h:
+        bar = (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]
+               and max(w, h) >= p.aspect * min(w, h) and area >= p.min_fill * w * h)
+        knob = not bar and not bars_only and p.knobs and _is_knob(w, h, area, o.res, p)
+        if not (bar or knob):
             continue
         if p.seam_share > 0:
             seams = _long_seams(o, cfg, L) if seams is None else seams
@@ -195,8 +199,15 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
         if p.side_cover > 0 and min(_side_cover(ref, (x, y, w, h), pad)) < p.side_cover:
             continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
-        out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1)))
+        out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
     return out
+
+
+def _is_knob(w: int, h: int, area: int, res: float, p: HandleConfig) -> bool:
+    """A blob of ``w`` x ``h`` px holding ``area`` px is a knob: both sides within ``knob_size`` (m), at most
+    ``knob_aspect`` long for its width, filling ``knob_min_fill`` of its box (a disc fills pi / 4)."""
+    return bool(p.knob_size[0] <= min(w, h) * res and max(w, h) * res <= p.knob_size[1]
+                and max(w, h) <= p.knob_aspect * min(w, h) and area >= p.knob_min_fill * w * h)
 
 
 def _long_seams(o: Orthophoto, cfg: HeuristicConfig, length_px: int) -> np.ndarray:
@@ -256,7 +267,8 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
             else:
                 along_c[h.box[0]:h.box[2]] = True
         learned = LearnedLines(lines[0], lines[1], cfg.lines.span, along_c, along_r)
-    cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, g, col, learned)
+    cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, g, col, learned,
+                   int(cells_cfg.edge_strip / o.res))
     for c in cells:
         c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     held = {id(h) for c in cells for h in c.handles}
@@ -440,12 +452,13 @@ def _plateau_middle(v: np.ndarray) -> int:
 
 def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: SeamConfig, q: CellConfig, min_px: int,
            depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray,
-           col: np.ndarray, learned: LearnedLines | None = None) -> list[Cell]:
+           col: np.ndarray, learned: LearnedLines | None = None, strip_px: int = 0) -> list[Cell]:
     """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at a line that
     ``learned`` line segments support, else at the most prominent seam by valley counts.
     Inside a cell holding handles, a horizontal cut must leave a handle on both sides (glossy fronts
     reflect horizontal table and shelf edges at a constant height; a drawer above a door carries its own
-    handle)."""
+    handle) — unless the side without one is a strip at most ``strip_px`` tall along the cell's top or
+    bottom edge (``cells.edge_strip``): a plinth or a worktop's edge, cut off and dropped."""
     if depth >= q.max_split_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
@@ -459,8 +472,8 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
             else:
                 a = Cell(c.c0, c.r0, c.c1, c.r0 + oh, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
                 b = Cell(c.c0, c.r0 + oh + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
-            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned)
-                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned))
+            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px)
+                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px))
     cv_, sc_v = _dip_cut(g[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
     ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
     sc_v = sc_v if sc_v >= p.dip_z else 0.0
@@ -495,7 +508,13 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
     mine = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     if sc_h and mine:
         cut = c.r0 + ch_
-        if not (any(h.center[1] < cut for h in mine) and any(h.center[1] > cut for h in mine)):
+        above, below = any(h.center[1] < cut for h in mine), any(h.center[1] > cut for h in mine)
+        if not (above and below):
+            if sc_h >= sc_v and _edge_strip(c, cut, above, strip_px, mine):
+                # the strip is no front: the cell goes on without it, its sides as they were
+                rest = (Cell(c.c0, c.r0, c.c1, cut, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts) if above
+                        else Cell(c.c0, cut + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts))
+                return _split(rest, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px)
             sc_h = 0.0
     if max(sc_v, sc_h) == 0.0:
         return [c]
@@ -506,8 +525,19 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
     else:
         a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=n, seam_cuts=k)
         b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=n, seam_cuts=k)
-    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned)
-            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned))
+    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px)
+            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px))
+
+
+def _edge_strip(c: Cell, cut: int, above: bool, strip_px: int, handles: list[Handle]) -> bool:
+    """Whether a horizontal cut at row ``cut`` leaves, on the side without handles, a strip along the cell's
+    top or bottom edge at most ``strip_px`` tall (the handles lie ``above`` the cut or below it), no handle's
+    box reaching into it."""
+    if strip_px <= 0:
+        return False
+    if above:  # the strip is below the cut, down to the cell's bottom edge
+        return c.r1 - cut <= strip_px and all(h.box[3] <= cut for h in handles)
+    return cut - c.r0 <= strip_px and all(h.box[1] > cut for h in handles)
 
 
 def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: SeamConfig,

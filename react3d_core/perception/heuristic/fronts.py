@@ -352,8 +352,11 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
     centre = on_plane(cu, cv)
     if hpts is not None:
         hu, hv = hpts @ f.u, hpts[:, 2]
-        horizontal = np.ptp(hu) >= np.ptp(hv)
+        su, sv = float(np.ptp(hu)), float(np.ptp(hv))
         hcu, hcv = float(hu.mean()), float(hv.mean())
+        horizontal = su >= sv
+        if max(su, sv) < r.knob_max_aspect * min(su, sv):  # a knob: centred on a drawer, at a door's edge
+            horizontal = abs(hcu - cu) <= r.knob_centre * f.w
     else:
         horizontal, hcu, hcv = None, cu, cv
     stacked = any(side == "vertical" for _, side in neighbours)  # a same-width front above/below: a stack

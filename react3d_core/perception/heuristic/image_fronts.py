@@ -332,7 +332,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         if hc.shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
             eye_row = int(np.floor((o.v_top - float(np.median(cams[:, 2]))) / o.res))  # cameras' median height
             holes = enclosed_holes(o.n_views > 0, outline, o.res, hc.shadow_min_thick, row_limit=eye_row)
-            shadows = find_handles(o, cov, cfg, np.zeros_like(diff), holes, outline) if holes.any() else []
+            shadows = find_handles(o, cov, cfg, np.zeros_like(diff), holes, outline, bars_only=True) if holes.any() else []
         thr = off_threshold(diff, o.n_views > 0, cfg)
         clutter = (diff > thr) & (o.n_views > 0)
         structure = thin_lines(clutter, o.res, clut.line_min_len, clut.line_max_width)

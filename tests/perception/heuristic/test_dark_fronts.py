@@ -1,0 +1,138 @@
+"""Where the image path loses dark fronts (the depth sensor missed them; the scan is completed with a slab
+coloured from the views): the mechanisms traced on the dark tuning scenes, each on a constructed
+orthophoto — knob handles, which have no bar's shape."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
+from react3d_core.perception.heuristic.front_cells import _is_knob, find_handles, split_cells
+from react3d_core.perception.heuristic.fronts import Front, _joint
+from react3d_core.perception.heuristic.orthophoto import Orthophoto
+from react3d_core.perception.heuristic.planes import Plane
+
+
+def _ortho(img: np.ndarray, res: float = 0.004) -> Orthophoto:
+    """An orthophoto of plane y = 0 facing -y (u along x), every pixel seen by 5 views."""
+    h, w = img.shape[:2]
+    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
+                  (0.0, w * res), (0.0, h * res), w * h * res * res)
+    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+
+
+def _disc(img: np.ndarray, r: int, c: int, radius: int, value: float) -> None:
+    rr, cc = np.mgrid[:img.shape[0], :img.shape[1]]
+    img[(rr - r) ** 2 + (cc - c) ** 2 <= radius ** 2] = value
+
+
+def test_knob_shape() -> None:
+    """At 4 mm: a 12 x 12 px blob (4.8 cm) filling 113 px (a disc of radius 6: 0.78 of its box) is a knob;
+    the same box filled 0.5 (speckle on a dark front) is not, nor a 20 x 20 px blob (8 cm: a socket), a
+    5 x 5 px one (2 cm) or a 12 x 24 px one (aspect 2 > 1.6)."""
+    p = HeuristicConfig().handles
+    assert _is_knob(12, 12, 113, 0.004, p)
+    assert not _is_knob(12, 12, 72, 0.004, p)
+    assert not _is_knob(20, 20, 314, 0.004, p)
+    assert not _is_knob(5, 5, 20, 0.004, p)
+    assert not _is_knob(12, 24, 230, 0.004, p)
+
+
+def test_knobs_split_stacked_dark_drawers() -> None:
+    """A 0.44 x 0.75 m dark column (110 x 188 px, 0.15 of the plane's exposure, a little noise, no visible
+    seam) holding three drawers, each with a pale knob 5 cm across (disc radius 6 px) in its middle at rows
+    31, 94, 157. A knob is no bar (10-50 cm long, aspect >= 2.2), so without knobs the column has no
+    handle and stays one cell; with them it is cut between each pair of knobs, into three cells."""
+    rng = np.random.default_rng(7)
+    img = np.full((188, 110, 3), 0.15, np.float32) + rng.normal(0, 0.003, (188, 110, 3)).astype(np.float32)
+    for r in (31, 94, 157):
+        _disc(img, r, 55, 6, 0.9)
+    o = _ortho(img)
+    cov = np.ones(img.shape[:2], bool)
+    off = HeuristicConfig(handles={"knobs": False})
+    on = HeuristicConfig()
+    assert find_handles(o, cov, off) == []
+    knobs = find_handles(o, cov, on)
+    assert len(knobs) == 3 and all(k.knob for k in knobs)
+    assert len(split_cells(o, cov, find_handles(o, cov, off), off)) == 1
+    cells = split_cells(o, cov, knobs, on)
+    assert len(cells) == 3
+    assert [len(c.handles) for c in cells] == [1, 1, 1]
+    cuts = sorted(c.r0 for c in cells)[1:]
+    assert 40 <= cuts[0] <= 85 and 103 <= cuts[1] <= 148
+
+
+def _front(w: float, h: float) -> Front:
+    return Front(facet=-1, handle_facets=[], center=np.array([w / 2, 0.0, 0.5 + h / 2]), n_out=np.array([0.0, -1.0, 0.0]),
+                 u=np.array([1.0, 0.0, 0.0]), extent_u=(0.0, w), extent_v=(0.5, 0.5 + h), faces=np.zeros(0, np.int64))
+
+
+def _knob_points(u: float, v: float, d: float = 0.04) -> np.ndarray:
+    """Points of a knob d across, centred at (u, z=v) on the plane y = 0: a square grid (extent d both ways)."""
+    g = np.linspace(-d / 2, d / 2, 5)
+    uu, vv = np.meshgrid(g + u, g + v)
+    return np.stack([uu.ravel(), np.zeros(uu.size), vv.ravel()], 1)
+
+
+def test_knob_types_the_joint_by_where_it_sits() -> None:
+    """A knob has no direction (its extent is the same both ways), so ``ptp(u) >= ptp(v)`` read it as a
+    horizontal bar and a 0.45 x 0.7 m door with a knob at its right edge became a drop door. Read by its
+    place: at the edge (0.19 m from the centre line, over 0.25 x 0.45) it is a door hinged on the far (left)
+    side; centred on a 0.5 x 0.2 m front it is a drawer. With ``knob_centre`` 0.5 every knob reads as
+    a horizontal bar, as before the rule."""
+    r = FrontRulesConfig()
+    door = _front(0.45, 0.7)
+    kind, art = _joint(door, _knob_points(0.415, 0.85), [], r)
+    assert kind == "door" and abs(art.axis[2]) == 1.0 and art.origin[0] == 0.0
+    assert _joint(door, _knob_points(0.415, 0.85), [], FrontRulesConfig(knob_centre=0.5))[0] == "drop"
+    drawer = _front(0.5, 0.2)
+    assert _joint(drawer, _knob_points(0.25, 0.6), [], r)[0] == "drawer"
+
+
+def test_plinth_strip_comes_off_a_handled_front() -> None:
+    """A dark drawer front 0.5 m wide (125 px, 0.15 of the exposure) with a pale bar handle (0.18 m x 2 cm,
+    rows 45-49), standing on a 0.1 m plinth strip of another shade (rows 100-124, 0.4), as a slab over a
+    dark unit takes it in. The colour step at row 100 is the cell's strongest line, but a horizontal cut
+    in a cell holding a handle must leave a handle on both sides: without the strip rule
+    (``cells.edge_strip`` 0) the cut is refused and the front keeps the plinth (125 rows); with it the
+    handle-less strip along the bottom edge (25 rows = 0.1 m <= 0.2 m) is cut off and dropped."""
+    rng = np.random.default_rng(11)
+    img = np.full((125, 125, 3), 0.15, np.float32) + rng.normal(0, 0.003, (125, 125, 3)).astype(np.float32)
+    img[100:] = 0.4 + rng.normal(0, 0.003, (25, 125, 3)).astype(np.float32)
+    img[45:50, 40:85] = 0.9
+    o = _ortho(img)
+    cov = np.ones(img.shape[:2], bool)
+    off = HeuristicConfig(cells={"edge_strip": 0.0})
+    on = HeuristicConfig()
+    handles = find_handles(o, cov, on)
+    assert len(handles) == 1 and not handles[0].knob
+    kept = split_cells(o, cov, handles, off)
+    assert [(c.r0, c.r1) for c in kept] == [(0, 125)]
+    trimmed = split_cells(o, cov, handles, on)
+    assert len(trimmed) == 1 and trimmed[0].r0 == 0 and 98 <= trimmed[0].r1 <= 101
+    assert len(trimmed[0].handles) == 1
+    # a handle-less part taller than edge_strip is not a strip: the cut is refused as before
+    assert [(c.r0, c.r1) for c in split_cells(o, cov, handles, HeuristicConfig(cells={"edge_strip": 0.08}))] == [(0, 125)]
+
+
+def test_bench_dark_fronts_box_and_f1_by_hand() -> None:
+    """benchmarks/bench_dark_fronts.py scores a front as a 2 cm box on its rectangle: a 0.4 x 0.2 m front
+    (u along x) against a part box 0.4 x 0.3 m sharing its left, right and bottom edges has IoU
+    0.08 / 0.12 = 2/3 (front_box_iou, the evaluator's); a tall front's box has z as its longest side. F1 is
+    2 TP / (predictions + parts): 3 matches of 4 predictions for 5 parts -> 6 / 9."""
+    from benchmarks.bench_dark_fronts import f1, front_box
+    from react3d_core.data.parts import OBB
+    from react3d_core.metrics.scene_metrics import front_box_iou
+
+    wide = Front(facet=-1, handle_facets=[], center=np.array([0.2, 0.0, 0.6]), n_out=np.array([0.0, -1.0, 0.0]),
+                 u=np.array([1.0, 0.0, 0.0]), extent_u=(0.0, 0.4), extent_v=(0.5, 0.7), faces=np.zeros(0, np.int64))
+    part = OBB(center=(0.2, 0.0, 0.65), axes=((1.0, 0, 0), (0, 0, 1.0), (0, -1.0, 0)), extents=(0.4, 0.3, 0.02))
+    box = front_box(wide)
+    assert box.extents == (0.4, pytest.approx(0.2), 0.02) and box.axes[0] == (1.0, 0.0, 0.0)
+    assert front_box_iou(box, part) == pytest.approx(2 / 3, abs=1e-6)
+    tall = _front(0.4, 0.7)
+    assert front_box(tall).axes[0] == (0.0, 0.0, 1.0) and front_box(tall).extents[0] == pytest.approx(0.7)
+    assert f1(3, 4, 5) == pytest.approx(6 / 9)
+    assert f1(0, 0, 0) == 0.0
+
