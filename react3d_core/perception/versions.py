@@ -22,6 +22,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 16: a straight seam dips in every 0.3 m piece of its length (seams.piece_*), the cut between stacked
 #     handles is sought between their centres, a front's own handles are no clutter in the mesh-front veto,
 #     a blob lying on a long straight seam is no handle (handles.seam_share)
-HEURISTIC_VERSION = "16"
+# 17: the mesh-front veto judges a front against its own rectangle's background, by the plane's threshold,
+#     with the surface standing out of the plane (handles in the mesh) left out
+HEURISTIC_VERSION = "17"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
