@@ -25,6 +25,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 17: knobs are handles (handles.knobs: compact round blobs), and a knob types its front by where it sits
 #     (fronts.knob_*: centred is a drawer's or a flap's, off-centre a door's opening edge); a handle-less strip
 #     along a handled cell's top or bottom edge is cut off (cells.edge_strip: plinths, worktop edges)
-HEURISTIC_VERSION = "17"
+# 18: the mesh-front veto judges a front against its own rectangle's background, by the plane's threshold,
+#     with the surface standing out of the plane (handles in the mesh) left out
+HEURISTIC_VERSION = "18"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

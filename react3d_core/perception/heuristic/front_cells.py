@@ -122,12 +122,18 @@ def seam_maps(o: Orthophoto, cfg: HeuristicConfig) -> tuple[np.ndarray, np.ndarr
 
 def off_background(o: Orthophoto, h: HandleConfig) -> np.ndarray:
     """Colour distance of every pixel from its local background (median over ``background_win``)."""
-    valid = o.n_views > 0
+    return off_local(o.color, o.n_views > 0, o.res, h)
+
+
+def off_local(color: np.ndarray, valid: np.ndarray, res: float, h: HandleConfig) -> np.ndarray:
+    """Colour distance of every pixel of ``color`` (an orthophoto or a window of one, ``res`` m per px) from
+    its local background: the median over ``background_win`` of the ``valid`` pixels' colours, the array
+    mirrored beyond its border."""
     if not valid.any():
         return np.zeros(valid.shape, np.float32)
-    c = np.clip(o.color * _U8, 0, _U8_MAX).astype(np.uint8)
+    c = np.clip(color * _U8, 0, _U8_MAX).astype(np.uint8)
     c[~valid] = np.median(c[valid], axis=0).astype(np.uint8)  # unseen pixels must not look like blobs
-    k = min(max(MIN_KERNEL, int(h.background_win / o.res) | 1), _U8_MAX)
+    k = min(max(MIN_KERNEL, int(h.background_win / res) | 1), _U8_MAX)
     # mirrored, not replicated, beyond the orthophoto's border: medianBlur repeats the last row, so a dark
     # band along a wall cabinet's bottom edge filled half the window of a flap's handle 5 cm above it
     # and the bar matched its "background"

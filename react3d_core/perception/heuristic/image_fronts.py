@@ -21,7 +21,7 @@ from ...config.heuristic import FloorConfig, HandleConfig, HeuristicConfig, Imag
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
-from .front_cells import Cell, Handle, find_handles, off_background, off_threshold, split_cells
+from .front_cells import Cell, Handle, find_handles, off_background, off_local, off_threshold, split_cells
 from .fronts import Front, _joint, _neighbours, doors_in_rows
 from .line_evidence import LineSupport, line_support
 from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
@@ -308,7 +308,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     centroids = mesh.face_centroids
     fronts: list[Front] = []
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
-    diffs = []
+    veto_evidence: list[VetoEvidence] = []
     for i, o in enumerate(orthos):
         if cfg.image.surface_rays:
             surf = cast_surface(o.grid_points(), o.plane.n, raster, cfg.planes.offset_tol, hc.protrusion_depth[1],
@@ -327,13 +327,13 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         bars = (protrusion_map(o, surf, hc, win, cfg.planes.offset_tol) if cfg.image.surface_rays
                 else protrusion_from_faces(o, centroids, mesh.face_normals, hc, win, cfg.planes.offset_tol))
         handles = find_handles(o, cov, cfg, diff, bars & outline, outline)
-        diffs.append(_without_handles(diff, handles))
+        thr = off_threshold(diff, o.n_views > 0, cfg)
+        veto_evidence.append(VetoEvidence(thr, _hardware(bars, handles)))
         shadows: list[Handle] = []
         if hc.shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells
             eye_row = int(np.floor((o.v_top - float(np.median(cams[:, 2]))) / o.res))  # cameras' median height
             holes = enclosed_holes(o.n_views > 0, outline, o.res, hc.shadow_min_thick, row_limit=eye_row)
             shadows = find_handles(o, cov, cfg, np.zeros_like(diff), holes, outline, bars_only=True) if holes.any() else []
-        thr = off_threshold(diff, o.n_views > 0, cfg)
         clutter = (diff > thr) & (o.n_views > 0)
         structure = thin_lines(clutter, o.res, clut.line_min_len, clut.line_max_width)
         for h in handles:  # a handle is not clutter
@@ -368,7 +368,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else f.shadow_points
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
-    vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, diffs, cfg)})
+    vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, veto_evidence, cfg)})
     return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
 
 
@@ -415,25 +415,41 @@ def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh
     return kept, split
 
 
-def _without_handles(diff: np.ndarray, handles: Sequence[Handle]) -> np.ndarray:
-    """``diff`` with the handles' pixels set to 0: what the mesh-front veto (``_cluttered``) counts. A front's
-    own handle is no clutter: a 0.3 x 0.03 m bar fills an eighth of a 0.4 x 0.18 m drawer, which with a few
-    off pixels along its edges passed ``clutter.max_share`` and the drawer was vetoed (clean kitchen 101)."""
-    if not handles:
-        return diff
-    out = diff.copy()
+@dataclass
+class VetoEvidence:
+    """What the mesh-front veto (``_cluttered``) reads off one orthophoto besides its colours: the plane's
+    off-background threshold (``off_threshold``: raised on wood grain) and its hardware, the pixels of the
+    handles found and of the surface standing out of the plane (handles in the mesh)."""
+
+    threshold: float
+    hardware: np.ndarray  # bool per grid pixel
+
+
+def _hardware(bars: np.ndarray, handles: Sequence[Handle]) -> np.ndarray:
+    """Pixels of ``handles`` and of the surface standing out of the plane (``bars``). A front's own handle is
+    no clutter: a 0.3 x 0.03 m bar fills an eighth of a 0.4 x 0.18 m drawer, which with a few off pixels
+    along its edges passed ``clutter.max_share`` and the drawer was vetoed (clean kitchen 101); a bar longer
+    than any handle (a scene-synthesizer drawer's 0.8 m rail) is not found as a handle, but stands out of
+    the front in the scan."""
+    out = bars.astype(bool).copy()
     for h in handles:
-        out[h.pixels[:, 1], h.pixels[:, 0]] = 0.0
+        out[h.pixels[:, 1], h.pixels[:, 0]] = True
     return out
 
 
-def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarray], cfg: HeuristicConfig) -> bool:
-    """A mesh front whose picture is cluttered (a tiled wall with a socket "handle") is not a front:
-    its rectangle in the orthophoto of its plane has more than ``clutter.max_share`` off-background pixels
-    (``diffs``: each orthophoto's off-background map, computed once, its handles left out; ``image.veto_*``:
-    which plane, how much seen)."""
+def _cluttered(f: Front, orthos: Sequence[Orthophoto], evidence: Sequence[VetoEvidence], cfg: HeuristicConfig) -> bool:
+    """A mesh front whose picture is cluttered (a tiled wall with a socket "handle") is not a front: more
+    than ``clutter.max_share`` of the seen pixels of its rectangle, in the orthophoto of its plane, are off
+    their local background by the plane's threshold (``evidence``), hardware left out (``image.veto_*``:
+    which plane, how much seen).
+
+    The background is taken inside the rectangle only (mirrored at its edges), as the front's own: the
+    orthophoto's 12 cm median reaches over a small front's outline into the frame or the neighbours around
+    it (or the plane's median colour filled into unseen pixels beside it), and every pixel near its
+    corners came out off (scene-synthesizer drawers 0.25 x 0.15 m in a frame: 18-68 % off). The threshold
+    is the plane's, as for handles and cells: on wood grain every pixel deviates by the fixed contrast."""
     im = cfg.image
-    for o, diff_o in zip(orthos, diffs):
+    for o, ev in zip(orthos, evidence):
         p = o.plane
         if np.dot(p.n, f.n_out) < cfg.fronts.parallel_cos or abs(float(f.center @ p.n) - p.d) > im.veto_plane_offset:
             continue
@@ -446,8 +462,9 @@ def _cluttered(f: Front, orthos: Sequence[Orthophoto], diffs: Sequence[np.ndarra
         seen = o.n_views[r0:r1, c0:c1] > 0
         if seen.sum() < im.veto_min_seen * seen.size:
             continue
-        diff = diff_o[r0:r1, c0:c1]
-        return bool((diff[seen] > cfg.handles.contrast).mean() > cfg.clutter.max_share)
+        diff = off_local(o.color[r0:r1, c0:c1], seen, o.res, cfg.handles)
+        off = (diff > ev.threshold) & seen & ~ev.hardware[r0:r1, c0:c1]
+        return bool(off.sum() > cfg.clutter.max_share * seen.sum())
     return False
 
 

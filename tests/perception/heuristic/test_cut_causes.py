@@ -12,7 +12,7 @@ from react3d_core.config.heuristic import HeuristicConfig, SeamConfig
 from react3d_core.perception.heuristic.front_cells import (Cell, Handle, _between, _dip_scores, _split_handles,
                                                            find_handles, split_cells)
 from react3d_core.perception.heuristic.fronts import Front
-from react3d_core.perception.heuristic.image_fronts import _cluttered, _without_handles
+from react3d_core.perception.heuristic.image_fronts import VetoEvidence, _cluttered, _hardware
 from react3d_core.perception.heuristic.orthophoto import Orthophoto
 from react3d_core.perception.heuristic.planes import Plane
 
@@ -81,24 +81,24 @@ def test_cut_between_stacked_handles_finds_the_seam_inside_a_handle_box() -> Non
 
 
 def test_a_fronts_own_handle_is_no_clutter() -> None:
-    """A 0.4 x 0.18 m drawer (4 mm px: 100 x 45 px) on the plane, its 0.3 x 0.03 m bar handle (75 x 7 =
-    525 px, 11.7 %) off the background and 7 % of the other pixels off too (315 px, the worktop edge's
-    shadow): 840 / 4500 = 18.7 % is over clutter.max_share 0.18, so the mesh front was vetoed; without its
-    handle 315 / 4500 = 7 %."""
+    """A 0.4 x 0.18 m drawer (4 mm px: 100 x 45 px, colour 1.0) alone in the orthophoto, its 0.3 x 0.03 m bar
+    handle (75 x 7 = 525 px, 11.7 %, colour 1.6) off the background and 7 % of the other pixels off too (315
+    px dark, the worktop edge's shadow): 840 / 4500 = 18.7 % is over clutter.max_share 0.18, so the mesh front
+    was vetoed; without its handle 315 / 4500 = 7 %."""
     h, w, res = 45, 100, 0.004
-    o = _ortho(np.ones((h, w, 3), np.float32), res)
-    diff = np.zeros((h, w), np.float32)
+    img = np.ones((h, w, 3), np.float32)
     rr, cc = np.meshgrid(np.arange(10, 17), np.arange(12, 87), indexing="ij")
-    diff[rr, cc] = 0.5
-    diff[0:3, :] = 0.5                                      # 300 px ...
-    diff[3, :15] = 0.5                                      # ... + 15 = 315
+    img[rr, cc] = 1.6
+    img[0:3, :] = 0.5                                       # 300 px ...
+    img[3, :15] = 0.5                                       # ... + 15 = 315
+    o = _ortho(img, res)
     handle = Handle((12, 10, 87, 17), True, np.stack([cc.ravel(), rr.ravel()], 1))
     f = Front(facet=0, handle_facets=[], center=np.array([0.2, 0.0, 0.09]), n_out=np.array([0.0, -1.0, 0.0]),
               u=np.array([1.0, 0.0, 0.0]), extent_u=(0.0, 0.4), extent_v=(0.0, 0.18), faces=np.zeros(0, np.int64))
     cfg = HeuristicConfig()
-    assert (diff > cfg.handles.contrast).mean() > cfg.clutter.max_share
-    assert _cluttered(f, [o], [diff], cfg)
-    assert not _cluttered(f, [o], [_without_handles(diff, [handle])], cfg)
+    none = np.zeros((h, w), bool)
+    assert _cluttered(f, [o], [VetoEvidence(cfg.handles.contrast, _hardware(none, []))], cfg)
+    assert not _cluttered(f, [o], [VetoEvidence(cfg.handles.contrast, _hardware(none, [handle]))], cfg)
 
 
 def test_piece_of_a_fused_seam_is_no_handle() -> None:
