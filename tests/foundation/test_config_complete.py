@@ -406,7 +406,7 @@ DEFAULTS = {
     "perception.heuristic.handles.bar_close_px": 5,
     "perception.heuristic.handles.shadows": True,
     "perception.heuristic.handles.shadow_min_thick": 0.03,
-    "perception.heuristic.handles.knobs": True,
+    "perception.heuristic.handles.knobs": False,
     "perception.heuristic.handles.knob_size": (0.025, 0.065),
     "perception.heuristic.handles.knob_aspect": 1.6,
     "perception.heuristic.handles.knob_min_fill": 0.7,

@@ -31,7 +31,7 @@ def test_knob_shape() -> None:
     """At 4 mm: a 12 x 12 px blob (4.8 cm) filling 113 px (a disc of radius 6: 0.78 of its box) is a knob;
     the same box filled 0.5 (speckle on a dark front) is not, nor a 20 x 20 px blob (8 cm: a socket), a
     5 x 5 px one (2 cm) or a 12 x 24 px one (aspect 2 > 1.6)."""
-    p = HeuristicConfig().handles
+    p = HeuristicConfig(handles={"knobs": True}).handles
     assert _is_knob(12, 12, 113, 0.004, p)
     assert not _is_knob(12, 12, 72, 0.004, p)
     assert not _is_knob(20, 20, 314, 0.004, p)
@@ -51,7 +51,7 @@ def test_knobs_split_stacked_dark_drawers() -> None:
     o = _ortho(img)
     cov = np.ones(img.shape[:2], bool)
     off = HeuristicConfig(handles={"knobs": False})
-    on = HeuristicConfig()
+    on = HeuristicConfig(handles={"knobs": True})
     assert find_handles(o, cov, off) == []
     knobs = find_handles(o, cov, on)
     assert len(knobs) == 3 and all(k.knob for k in knobs)
@@ -104,7 +104,7 @@ def test_plinth_strip_comes_off_a_handled_front() -> None:
     o = _ortho(img)
     cov = np.ones(img.shape[:2], bool)
     off = HeuristicConfig(cells={"edge_strip": 0.0})
-    on = HeuristicConfig()
+    on = HeuristicConfig(handles={"knobs": True})
     handles = find_handles(o, cov, on)
     assert len(handles) == 1 and not handles[0].knob
     kept = split_cells(o, cov, handles, off)
