@@ -127,11 +127,16 @@ def dedup_plan(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence[np
         inside = alive & (size > size[i]) & (contained[i] >= cfg.tau_contained)
         if alive[i] and inside.any():
             alive[i] = False
+    # a scrap (smaller than any front) shares its few vertices with every neighbour: no bridge, stage 5 merges it
+    scrap = np.array([b.extents[0] < cfg.scrap_max_m or b.extents[1] < cfg.scrap_max_m for b in boxes]
+                     if boxes is not None else np.zeros(n, bool), bool)
     for i in order:  # stage 3, bridges: larger first, so a bridge goes before the fronts it spans are judged
+        if not alive[i] or scrap[i]:
+            continue
         holders = np.flatnonzero(alive & (contained[i] >= cfg.tau_low))
         holders = holders[holders != i]
-        if not alive[i] or len(holders) < 2 or (boxes is not None and min(boxes[i].extents[:2]) < cfg.scrap_max_m):
-            continue  # a scrap shares its few vertices with every neighbour: stage 5 merges it instead
+        if len(holders) < 2:
+            continue
         union = np.unique(np.concatenate([sets_u[j] for j in holders]))
         if np.isin(sets_u[i], union, assume_unique=True).mean() >= cfg.bridge_share:
             alive[i] = False
@@ -150,24 +155,21 @@ def dedup_plan(sets: Sequence[np.ndarray], cfg: DedupConfig, points: Sequence[np
                 continue
             art_i, n_i, slide_i = motions[i]
             best, into = cfg.motion_share, -1
-            scrap = points is not None and len(points[i]) > 0 and min(boxes[i].extents[:2]) < cfg.scrap_max_m
-            if scrap:  # into the part that reaches most of it, shares most of its vertices (its surface), is nearest
+            if scrap[i] and points is not None and len(points[i]):
+                # into the part that reaches most of it, shares most of its vertices (its surface), is nearest
                 fits = [(float(_footprint_mask(points[i], boxes[j], cfg.motion_slab_m, cfg.scrap_reach_m).mean()),
                          float(inter[i, j]), -_outside_m(points[i], boxes[j]), int(j))
                         for j in np.flatnonzero(alive & (size > size[i]))]
                 fits = [t for t in fits if t[0] >= cfg.tau_contained]
-                if fits:
-                    into = max(fits)[-1]
-                    alive[i] = False
-                    merged.setdefault(into, []).append(int(i))
-                continue
-            for j in np.flatnonzero(alive & (size > size[i])):
-                art_j, n_j, slide_j = motions[j]
-                if slide_i != slide_j or not same_motion(art_i, art_j, n_i, n_j, cfg):
-                    continue
-                share = footprint_share(boxes[i], boxes[j], cfg.footprint_margin_m, cfg.motion_slab_m)
-                if share >= best:
-                    best, into = share, int(j)
+                into = max(fits)[-1] if fits else -1
+            else:
+                for j in np.flatnonzero(alive & (size > size[i])):
+                    art_j, n_j, slide_j = motions[j]
+                    if slide_i != slide_j or not same_motion(art_i, art_j, n_i, n_j, cfg):
+                        continue
+                    share = footprint_share(boxes[i], boxes[j], cfg.footprint_margin_m, cfg.motion_slab_m)
+                    if share >= best:
+                        best, into = share, int(j)
             if into >= 0:
                 alive[i] = False
                 merged.setdefault(into, []).append(int(i))
