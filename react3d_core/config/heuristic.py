@@ -113,6 +113,7 @@ class RoomWallConfig(StageConfig):
     min_area: float = Field(1.0, ge=0, description="... and the plane holds at least this much other surface (m^2) outside every front (a lone cabinet scanned from the front has no wall).")
     plane_tol: float = Field(0.03, ge=0, description="Surface in the front's plane: faces within this of it (m) ...")
     plane_min_cos: float = Field(0.9, ge=0, le=1, description="... facing the same way (cosine between the normals above this).")
+    wall_back: float = Field(0.3, ge=0, description="Surface behind the plane facing away from the room (cosine below -plane_min_cos), less than this (m) behind it, is the wall's own outer side (a modelled wall's thickness; no camera inside the room sees it), not scanned surface behind the wall (0: it counts).")
     door_min_h: float = Field(1.8, gt=0, description="Room door on an outer wall: at least this tall (m) ...")
     door_w: tuple[float, float] = Field((0.6, 1.3), description="... this wide (min, max; m) ...")
     door_floor_gap: float = Field(0.05, ge=0, description="... and its bottom edge this close to the floor (m).")

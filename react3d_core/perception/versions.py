@@ -27,6 +27,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     along a handled cell's top or bottom edge is cut off (cells.edge_strip: plinths, worktop edges)
 # 18: the mesh-front veto judges a front against its own rectangle's background, by the plane's threshold,
 #     with the surface standing out of the plane (handles in the mesh) left out
-HEURISTIC_VERSION = "18"
+# 19: a modelled wall's own outer side (facing away, within room_wall.wall_back) is not surface behind it
+HEURISTIC_VERSION = "19"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -274,6 +274,7 @@ DEFAULTS = {
     "perception.heuristic.room_wall.min_area": 1.0,
     "perception.heuristic.room_wall.plane_tol": 0.03,
     "perception.heuristic.room_wall.plane_min_cos": 0.9,
+    "perception.heuristic.room_wall.wall_back": 0.3,
     "perception.heuristic.room_wall.door_min_h": 1.8,
     "perception.heuristic.room_wall.door_w": (0.6, 1.3),
     "perception.heuristic.room_wall.door_floor_gap": 0.05,

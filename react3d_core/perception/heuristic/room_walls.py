@@ -26,7 +26,7 @@ from .image_fronts import floor_level
 
 def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> list[bool]:
     """Per front: does its plane have less than ``behind_share`` of the scan's area more than ``depth``
-    behind it, with at least ``min_area`` of other surface in the plane (within ``plane_tol``, facing
+    behind it (the wall's own outer side, ``wall_back``, left out), with at least ``min_area`` of other surface in the plane (within ``plane_tol``, facing
     the same way; see module docstring)?"""
     if not fronts:
         return []
@@ -38,7 +38,9 @@ def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> 
     out = []
     for f in fronts:
         d = (cen - f.center) @ f.n_out
-        behind = float(area[d < -rules.depth].sum()) / total
+        # a modelled wall's own outer side is behind it, facing away: nothing a camera in the room saw
+        own_back = (d > -rules.wall_back) & (nrm @ f.n_out < -rules.plane_min_cos)
+        behind = float(area[(d < -rules.depth) & ~own_back].sum()) / total
         wall = (np.abs(d) < rules.plane_tol) & (nrm @ f.n_out > rules.plane_min_cos) & ~in_front
         out.append(behind < rules.behind_share and float(area[wall].sum()) >= rules.min_area)
     return out

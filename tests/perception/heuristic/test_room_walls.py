@@ -89,3 +89,30 @@ def test_rule_switches_off() -> None:
     assert HeuristicConfig(room_wall={"enabled": False}).room_wall.enabled is False
     r = HeuristicConfig().room_wall
     assert r.enabled and r.behind_share == 0.005 and r.door_w == (0.6, 1.3)
+
+
+def _wall_back(x0: float, x1: float, y: float, z0: float, z1: float) -> tuple[np.ndarray, np.ndarray]:
+    """A rectangle in the plane y = ``y`` facing +y (away from the room): a modelled wall's outer side."""
+    v, f = _wall(x0, x1, y, z0, z1)
+    return v, f[:, ::-1].copy()
+
+
+def test_a_modelled_wall_s_own_outer_side_is_not_surface_behind_it() -> None:
+    """A 4 x 2.5 m wall at y = 3 modelled with thickness: its outer side, 4 x 2.5 m at y = 3.12 facing
+    +y, is half the mesh (10 / 20 m², share 0.5, far over behind_share 0.005), so a front painted on
+    the wall was not on an outer wall and its cells and 'handles' (the wall's paint at a room corner)
+    stayed fronts (tuning mixed rooms 13, 14: 6 false fronts each). No camera in the room sees that
+    side: within wall_back (0.3 m) and facing away (normal . n_out = -1 < -0.9) it is left out. A face
+    facing away 0.5 m behind (beyond wall_back), or one 0.12 m behind facing the room (a niche), still
+    counts; wall_back 0 restores the old reading."""
+    painted = [_front(1.0, 1.5, 1.0, 1.7, 3.0)]
+    rules = RoomWallConfig()
+    assert rules.wall_back == 0.3
+    thick = _mesh(_wall(0, 4, 3.0, 0, 2.5), _wall_back(0, 4, 3.12, 0, 2.5))
+    assert np.allclose(TriMesh(*concat_meshes([_wall_back(0, 4, 3.12, 0, 2.5)])).face_normals, [0.0, 1.0, 0.0])
+    assert on_outer_wall(painted, thick, rules) == [True]
+    assert on_outer_wall(painted, thick, RoomWallConfig(wall_back=0.0)) == [False]
+    far = _mesh(_wall(0, 4, 3.0, 0, 2.5), _wall_back(0, 4, 3.5, 0, 2.5))
+    assert on_outer_wall(painted, far, rules) == [False]
+    niche = _mesh(_wall(0, 4, 3.0, 0, 2.5), _wall(1, 1.3, 3.12, 1, 1.3))
+    assert on_outer_wall(painted, niche, rules) == [False]
