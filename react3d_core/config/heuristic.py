@@ -63,6 +63,7 @@ class FrontRulesConfig(StageConfig):
     door_max_deg: float = Field(100.0, gt=0, description="A side-hinged door's guessed opening (deg).")
     neighbour_gap: float = Field(0.03, ge=0, description="Coplanar fronts closer than this (m) are neighbours (door pairs, drawer stacks).")
     knob_max_aspect: float = Field(2.0, ge=1, description="A handle whose extent one way is less than this times the other is a knob, which has no direction: ...")
+    knob_max_size: float = Field(0.07, gt=0, description="... and is at most this across both ways (m; knobs are 2.5-6.5 cm, handles.knob_size): a larger compact blob in a front's middle (a raised panel's boss, a badge) has no knob's place to read, and keeps the bar reading.")
     knob_centre: float = Field(0.25, ge=0, le=0.5, description="... within this share of the front's width from its vertical centre line it is read as a horizontal bar (a drawer's or a flap's knob), farther out as a vertical one (a door's, at its opening edge).")
     row_overlap: float = Field(0.01, ge=0, description="Fronts in a row (doors_in_rows) may overlap side by side by this much (m) ...")
     row_min_height_share: float = Field(0.7, ge=0, le=1, description="... and share at least this part of the smaller one's height.")

@@ -28,6 +28,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 18: the mesh-front veto judges a front against its own rectangle's background, by the plane's threshold,
 #     with the surface standing out of the plane (handles in the mesh) left out
 # 19: a modelled wall's own outer side (facing away, within room_wall.wall_back) is not surface behind it
-HEURISTIC_VERSION = "19"
+# 20: only a knob-sized handle (fronts.knob_max_size) is typed by its place; a larger compact blob keeps the bar reading
+HEURISTIC_VERSION = "20"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -244,6 +244,7 @@ DEFAULTS = {
     "perception.heuristic.fronts.door_max_deg": 100.0,
     "perception.heuristic.fronts.neighbour_gap": 0.03,
     "perception.heuristic.fronts.knob_max_aspect": 2.0,
+    "perception.heuristic.fronts.knob_max_size": 0.07,
     "perception.heuristic.fronts.knob_centre": 0.25,
     "perception.heuristic.fronts.row_overlap": 0.01,
     "perception.heuristic.fronts.row_min_height_share": 0.7,

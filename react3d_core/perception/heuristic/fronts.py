@@ -355,7 +355,7 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
         su, sv = float(np.ptp(hu)), float(np.ptp(hv))
         hcu, hcv = float(hu.mean()), float(hv.mean())
         horizontal = su >= sv
-        if max(su, sv) < r.knob_max_aspect * min(su, sv):  # a knob: centred on a drawer, at a door's edge
+        if max(su, sv) < r.knob_max_aspect * min(su, sv) and max(su, sv) <= r.knob_max_size:  # a knob: centred on a drawer, at a door's edge
             horizontal = abs(hcu - cu) <= r.knob_centre * f.w
     else:
         horizontal, hcu, hcv = None, cu, cv

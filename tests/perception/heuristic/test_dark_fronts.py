@@ -90,6 +90,23 @@ def test_knob_types_the_joint_by_where_it_sits() -> None:
     assert _joint(drawer, _knob_points(0.25, 0.6), [], r)[0] == "drawer"
 
 
+def test_a_blob_larger_than_a_knob_keeps_the_bar_reading() -> None:
+    """A wall cabinet door 0.5 x 0.79 m (bottom at 1.275 m, above ``flap_min_top``) with a compact blob
+    6 x 9.5 cm in its middle (a raised panel's boss read as a handle): its aspect (1.58) is a knob's,
+    and read by its place (centred) it made the door a top-hinged flap. It is larger than any knob
+    (``knob_max_size`` 7 cm), so it keeps the bar reading: taller than wide, a vertical hinge. A 4 cm knob
+    at the same place still reads as a flap's knob."""
+    r = FrontRulesConfig()
+    door = Front(facet=-1, handle_facets=[], center=np.array([0.25, 0.0, 1.67]), n_out=np.array([0.0, -1.0, 0.0]),
+                 u=np.array([1.0, 0.0, 0.0]), extent_u=(0.0, 0.5), extent_v=(1.275, 2.065), faces=np.zeros(0, np.int64))
+    boss = _knob_points(0.25, 1.66, 0.06)  # a centimetre under the middle: a flap's place
+    boss[:, 2] = 1.66 + (boss[:, 2] - 1.66) * 0.095 / 0.06
+    kind, art = _joint(door, boss, [], r)
+    assert kind == "door" and abs(art.axis[2]) == 1.0
+    assert _joint(door, boss, [], FrontRulesConfig(knob_max_size=0.1))[0] == "flap"
+    assert _joint(door, _knob_points(0.25, 1.66), [], r)[0] == "flap"
+
+
 def test_plinth_strip_comes_off_a_handled_front() -> None:
     """A dark drawer front 0.5 m wide (125 px, 0.15 of the exposure) with a pale bar handle (0.18 m x 2 cm,
     rows 45-49), standing on a 0.1 m plinth strip of another shade (rows 100-124, 0.4), as a slab over a
