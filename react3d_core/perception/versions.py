@@ -27,6 +27,10 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     along a handled cell's top or bottom edge is cut off (cells.edge_strip: plinths, worktop edges)
 # 18: the mesh-front veto judges a front against its own rectangle's background, by the plane's threshold,
 #     with the surface standing out of the plane (handles in the mesh) left out
-HEURISTIC_VERSION = "18"
+# 19: pieces standing free in the room: slices through a turned surface are no planes and the faces no
+#     plane explains vote again (planes.max_skew_deg, planes.revote_rounds); a plane faces the way its
+#     faces' normals point (planes.normal_agree); handle-less cells stacked in a column are fronts
+#     (cells.stack_min)
+HEURISTIC_VERSION = "19"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
