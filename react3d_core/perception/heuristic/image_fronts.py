@@ -294,18 +294,15 @@ def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[in
 def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, read_rgb: Callable[[Frame], np.ndarray],
                       cfg: HeuristicConfig = HeuristicConfig(), taken_faces: np.ndarray | None = None,
                       mesh_fronts: Sequence[Front] = (),
-                      detect_lines: Callable[[np.ndarray], np.ndarray] | None = None,
-                      view_dirs: np.ndarray | None = None) -> ImageFronts:
+                      detect_lines: Callable[[np.ndarray], np.ndarray] | None = None) -> ImageFronts:
     """Fronts from the colour frames (see module docstring), by the rules of ``cfg``. ``taken_faces``
     (bool per face) are faces of fronts already found on the mesh: cells overlapping them are left to
     the mesh rules. ``detect_lines`` (an RGB image -> its line segments (N, 4+: x0, y0, x1, y1 px)) gives
-    learned seam evidence when ``lines.enabled`` (line_evidence.py). ``view_dirs`` (per face, the summed
-    directions towards the cameras that saw it) turns each plane towards the cameras that see it; without
-    it, towards the cameras' mean position, which for a piece standing free in the room may lie behind it."""
+    learned seam evidence when ``lines.enabled`` (line_evidence.py)."""
     rules, hc, clut = cfg.fronts, cfg.handles, cfg.clutter
     cams = np.array([f.c2w[:3, 3] for f in frames]) if len(frames) else np.zeros((1, XYZ))
     planes = vertical_planes(mesh, cams.mean(0), cfg.planes, max_tilt=rules.max_tilt,
-                             min_area=max(cfg.planes.min_area, rules.min_w * rules.min_h), view_dirs=view_dirs)
+                             min_area=max(cfg.planes.min_area, rules.min_w * rules.min_h))
     orthos, calib, per_view = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, cfg.ortho,
                                                 cfg.calibration, cfg.registration)
     supports: list[LineSupport] = []
