@@ -94,6 +94,21 @@ class ReachConfig(StageConfig):
     drawer_max_top: float = Field(1.7, ge=0, description="A drawer's top edge is at most this high above the floor (m): nothing slides out above eye level; a drawer-typed strip higher up is dropped; 0: no limit.")
 
 
+class LidConfig(StageConfig):
+    """A chest's front with a bar at its top is the lid's lip: the lid is the chest's top (perception/heuristic/lids.py)."""
+
+    enabled: bool = Field(True, description="Turn a wide drop-typed front level with a flat top of its own width into that top's lid, hinged at its back edge.")
+    min_w: float = Field(0.7, ge=0, description="Only fronts at least this wide (m): dishwasher and oven drop doors are 0.45-0.6 m.")
+    min_up: float = Field(0.9, ge=0, le=1, description="The top's faces: the normal's z is above this.")
+    band: float = Field(0.04, gt=0, description="The top lies level with the front's top edge within this (m); also the slack of the lid's box.")
+    min_depth: float = Field(0.4, gt=0, description="The top covers the rectangle this deep behind the front (m) ...")
+    cover: float = Field(0.6, ge=0, le=1, description="... by at least this share.")
+    max_depth: float = Field(1.0, gt=0, description="The lid reaches back at most this far (m).")
+    side: float = Field(0.2, gt=0, description="Strips this wide (m) beside the front, level with its top ...")
+    side_cover: float = Field(0.3, ge=0, le=1, description="... covered by at least this share mean a worktop runs on past it: a drop door under a worktop, not a lid.")
+    lip: float = Field(0.08, ge=0, description="The lid reaches this far below its top (m): its lip with the bar.")
+
+
 class SplashbackConfig(StageConfig):
     """Fronts standing on a worktop flush with the wall behind it are splash-back (perception/heuristic/splashback.py)."""
 
@@ -115,6 +130,7 @@ class RoomWallConfig(StageConfig):
     plane_tol: float = Field(0.03, ge=0, description="Surface in the front's plane: faces within this of it (m) ...")
     plane_min_cos: float = Field(0.9, ge=0, le=1, description="... facing the same way (cosine between the normals above this).")
     wall_back: float = Field(0.3, ge=0, description="Surface behind the plane facing away from the room (cosine below -plane_min_cos), less than this (m) behind it, is the wall's own outer side (a modelled wall's thickness; no camera inside the room sees it), not scanned surface behind the wall (0: it counts).")
+    wall_band: float = Field(0.1, ge=0, description="Surface up to this far (m) behind the front's plane counts as in it too: a radiator or a picture stands a few cm proud of the wall, with the wall around it and nothing behind (0: only plane_tol).")
     door_min_h: float = Field(1.8, gt=0, description="Room door on an outer wall: at least this tall (m) ...")
     door_w: tuple[float, float] = Field((0.6, 1.3), description="... this wide (min, max; m) ...")
     door_floor_gap: float = Field(0.05, ge=0, description="... and its bottom edge this close to the floor (m).")
@@ -171,6 +187,9 @@ class PlanesConfig(StageConfig):
     refit_step_deg: float = Field(0.1, gt=0, description="Directions tried by the refit are this far apart (deg).")
     refit_bin: float = Field(0.002, gt=0, description="The refit's offset density: bins of this size (m) ...")
     refit_sigma: float = Field(0.003, gt=0, description="... smoothed by a Gaussian of this sigma (m).")
+    max_skew_deg: float = Field(5.0, ge=0, description="A plane piece whose faces' normals are turned from its own normal by more than this on average (area-weighted, deg) is a slice through a surface at another angle (a turned cabinet's front cut along a wall's direction), not a plane; its faces vote again (0: no such test).")
+    normal_agree: float = Field(0.5, ge=0, le=1, description="A plane faces the way its faces' normals point when their area-weighted mean along its normal is at least this either way (a scan's faces face the free space the sensor looked through), else towards the cameras' mean position, which for a piece standing free in the room facing a wall lies behind it (0: always the cameras' mean position).")
+    revote_rounds: int = Field(1, ge=0, description="Rounds in which the vertical faces no plane holds vote again for directions at least direction_min_sep_bins from those found (a piece of furniture turned by ~10 degrees is hidden in the first vote by the walls' peak; 0: one vote).")
     min_area: float = Field(0.08, ge=0, description="Smallest vertical plane photographed (m^2; at least fronts.min_w x fronts.min_h).")
     cell: float = Field(0.04, gt=0, description="Pieces of one plane farther apart than this are separate planes (m).")
     min_fragment_area: float = Field(0.03, ge=0, description="Fragments of a plane's coverage smaller than this are not part of it (m^2).")
@@ -313,6 +332,7 @@ class CellConfig(StageConfig):
     min_seen: float = Field(0.55, ge=0, le=1, description="Share of a cell the plane's faces must cover.")
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
     handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")
+    stack_min: int = Field(3, ge=0, description="A handle-less cell in a column of at least this many door/drawer-sized cells stacked on one another, each as wide as the next (a drawer pedestal or chest with edge pulls or no handles), is a front; 0: off.")
 
 
 class ClutterConfig(StageConfig):
@@ -426,6 +446,7 @@ class HeuristicConfig(StageConfig):
     fronts: FrontRulesConfig = Field(default_factory=FrontRulesConfig, description="Front rules on the scan mesh.")
     floor: FloorConfig = Field(default_factory=FloorConfig, description="The floor's height.")
     reach: ReachConfig = Field(default_factory=ReachConfig, description="Drawers are within reach.")
+    lids: LidConfig = Field(default_factory=LidConfig, description="A chest's front with a bar at its top is the lid's lip.")
     splashback: SplashbackConfig = Field(default_factory=SplashbackConfig, description="Splash-back above a worktop is no front.")
     room_wall: RoomWallConfig = Field(default_factory=RoomWallConfig, description="Only room doors open on the room's outer walls.")
     sliding: SlidingConfig = Field(default_factory=SlidingConfig, description="Sliding-door pairs.")

@@ -29,6 +29,10 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     with the surface standing out of the plane (handles in the mesh) left out
 # 19: a modelled wall's own outer side (facing away, within room_wall.wall_back) is not surface behind it
 # 20: only a knob-sized handle (fronts.knob_max_size) is typed by its place; a larger compact blob keeps the bar reading
-HEURISTIC_VERSION = "20"
+# 21: pieces standing free in the room: slices through a turned surface are no planes and the faces no
+#     plane explains vote again (planes.max_skew_deg, planes.revote_rounds); a plane faces the way its
+#     faces' normals point (planes.normal_agree); handle-less cells stacked in a column are fronts
+#     (cells.stack_min); chest lids (lids); surface within room_wall.wall_band behind a front is in its plane
+HEURISTIC_VERSION = "21"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -25,6 +25,7 @@ from .facets import planar_facets
 from .constants import COLOUR_NDIM, RGB
 from .fronts import Front, find_fronts
 from .image_fronts import ImageFronts, find_image_fronts, floor_level
+from .lids import chest_lids
 from .reach import drawers_within_reach
 from .room_walls import keep_room_doors
 from .sliding import mark_sliding
@@ -83,6 +84,7 @@ class HeuristicModel:
             self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, h, taken, self.fronts,
                                            line_detector)
             self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
+        chest_lids(self.fronts, self.mesh, h.lids, rules.flap_max_deg)  # a chest's lip with a bar: its lid
         if h.splashback.enabled:  # fronts flush with the wall right above a worktop are splash-back
             self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, h.splashback)) if not drop]
         if h.room_wall.enabled:  # on the room's outer walls only room doors open

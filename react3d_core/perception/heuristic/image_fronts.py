@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import cv2
 import numpy as np
 
-from ...config.heuristic import FloorConfig, HandleConfig, HeuristicConfig, ImageConfig
+from ...config.heuristic import FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...raster import Rasterizer
@@ -70,11 +70,14 @@ def floor_level(mesh: TriMesh, cfg: FloorConfig) -> float:
     return float(mesh.vertices[:, 2].min()) if floor is None else floor
 
 
-def off_the_floor(fronts: list[Front], floor: float | None, gap: float) -> list[Front]:
-    """Fronts without a handle whose bottom edge is within ``gap`` of ``floor`` dropped (None: all kept)."""
+def off_the_floor(fronts: list[Front], floor: float | None, gap: float, stacked: set[int] | None = None) -> list[Front]:
+    """Fronts without a handle whose bottom edge is within ``gap`` of ``floor`` dropped (None: all kept),
+    except those whose ids are in ``stacked``: the bottom drawer of a pedestal on a recessed plinth reaches
+    the floor in the scan, and a wall is not cut into a column of drawer-sized cells (``stacks``)."""
     if floor is None:
         return list(fronts)
-    return [f for f in fronts if f.handle_points is not None or f.extent_v[0] > floor + gap]
+    keep = stacked or set()
+    return [f for f in fronts if f.handle_points is not None or f.extent_v[0] > floor + gap or id(f) in keep]
 
 
 def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) -> np.ndarray:
@@ -356,20 +359,49 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                     gridded.add(id(f))
     fronts, split_mesh = _settle_with_mesh_fronts(fronts, taken_faces, mesh_fronts, mesh.n_faces, cfg.image)
     # a handle-less cell is a front beside a front with a handle, or when straight seams along its whole
-    # length cut it out on ``handleless_min_seams`` sides (push-to-open fronts); tiles and splash-backs
+    # length cut it out on ``handleless_min_seams`` sides (push-to-open fronts), or in a column of
+    # ``stack_min`` stacked cells of one width (a drawer pedestal with edge pulls); tiles and splash-backs
     # have no handles and, tiled, cells smaller than a front
-    fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded
+    stacked = stacks(fronts, rules, cfg.cells.stack_min)
+    fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded or id(f) in stacked
               or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
     # ... but a handle-less panel that reaches down to the floor is wall (beside a room door, say): base
-    # units stand on a plinth and room doors have handles
+    # units stand on a plinth and room doors have handles; a stack's bottom drawer stays
     if cfg.image.plain_floor_gap > 0:
-        fronts = off_the_floor(fronts, floor_height(mesh, cfg.floor), cfg.image.plain_floor_gap)
+        fronts = off_the_floor(fronts, floor_height(mesh, cfg.floor), cfg.image.plain_floor_gap, stacked)
     for f in fronts:
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else f.shadow_points
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, veto_evidence, cfg)})
     return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
+
+
+def stacks(fronts: list[Front], rules: FrontRulesConfig, n: int) -> set[int]:
+    """Ids of the fronts in a column of at least ``n`` (0: none) fronts stacked one on another, each of
+    the same width as the next and touching it (``_neighbours`` above/below): a drawer pedestal, a chest
+    or a filing cabinet whose drawers have edge pulls or none. A wall is not cut into such a column of
+    drawer-sized cells; its cells are wall-wide or door-tall."""
+    if n <= 0:
+        return set()
+    col = {id(f): [g for g, side in _neighbours(f, fronts, rules) if side == "vertical"] for f in fronts}
+    out: set[int] = set()
+    seen: set[int] = set()
+    for f in fronts:
+        if id(f) in seen:
+            continue
+        group, todo = [], [f]
+        seen.add(id(f))
+        while todo:
+            g = todo.pop()
+            group.append(g)
+            for h in col[id(g)]:
+                if id(h) not in seen:
+                    seen.add(id(h))
+                    todo.append(h)
+        if len(group) >= n:
+            out.update(id(g) for g in group)
+    return out
 
 
 def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.ndarray | None:

@@ -82,34 +82,116 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
 
     A face belongs to a plane when its normal is within ``cfg.angle_tol_deg`` of the plane's horizontal
     normal (either sign) and its centroid within ``cfg.offset_tol`` of the plane. Normals point towards
-    the cameras (``view_dirs``: per-face summed directions to cameras that saw it, else
-    ``cam_center``). Pieces of one plane separated by more than ``cfg.cell`` become separate planes."""
+    the outside (``outward_signs``: the faces' own normals, else ``view_dirs``, per-face summed directions
+    to cameras that saw it, else ``cam_center``). Pieces of one plane separated by more than ``cfg.cell`` become separate planes."""
     min_area = cfg.min_area if min_area is None else min_area
-    angle_tol_deg, offset_tol, refit_deg = cfg.angle_tol_deg, cfg.offset_tol, cfg.refit_deg
     if mesh.n_faces == 0:
         return []
     nrm, area, cen = mesh.face_normals, mesh.face_areas, mesh.face_centroids
     vert = (np.abs(nrm[:, 2]) <= max_tilt) & (area > 0)
     if not vert.any():
         return []
-    # orientation-free direction histogram over [0, 180) degrees, 1-degree bins
+    # orientation-free direction of every face's normal over [0, 180) degrees
     theta = np.degrees(np.arctan2(nrm[:, 1], nrm[:, 0])) % _HALF_TURN
-    bins = np.floor(theta).astype(int) % _HALF_TURN_BINS
-    hist = np.bincount(bins[vert], weights=area[vert], minlength=_HALF_TURN_BINS)
-    hist = ndimage.uniform_filter1d(hist, cfg.direction_smooth_bins, mode="wrap")
-    planes: list[Plane] = []
-    peaks = np.array(_peaks(hist, min_area / cfg.direction_peak_div, cfg.direction_min_sep_bins, circular=True), float)
-    if not len(peaks):
-        return []
-    # each face goes to its nearest direction peak (a cabinet turned by 9 degrees is its own plane)
-    dist = np.abs(_wrapped(theta[:, None] - peaks[None]))
-    nearest = dist.argmin(1)
     vidx = np.flatnonzero(vert)
     sp, sf, sw = surface_samples(mesh.vertices[mesh.faces[vidx]], area[vidx], cfg.cell / _SAMPLES_PER_CELL)
     samples = _Samples(sp, vidx[sf], sw, np.zeros(len(cen), bool))
+    planes, found = _vote(vert, theta, area, cen, samples, cfg, min_area, [])
+    for _ in range(cfg.revote_rounds):
+        # faces no plane explains vote again, away from the directions found: a piece of furniture turned
+        # by ~10 degrees in the room is hidden in the first vote by the tail of the walls' peak
+        more, dirs = _vote(vert & ~_explained(planes, cen, cfg), theta, area, cen, samples, cfg, min_area, found)
+        if not more:
+            break
+        planes += more
+        found += dirs
+    signs = outward_signs(planes, nrm, area, cam_center, view_dirs, cfg.normal_agree)
+    out = [p if sg > 0 else _flip(p) for p, sg in zip(planes, signs)]
+    out.sort(key=lambda p: -p.area)
+    return out
+
+
+def outward_signs(planes: list[Plane], nrm: np.ndarray, area: np.ndarray, cam_center: np.ndarray,
+                  view_dirs: np.ndarray | None, normal_agree: float) -> list[float]:
+    """Per plane +1 when its normal points out of the surface, towards the cameras that saw it, else -1.
+
+    By the plane's faces' own normals when their area-weighted mean along ``p.n`` is at least
+    ``normal_agree`` either way (0: never): a scan mesh's faces face the free space the sensor looked
+    through. Else (and for every plane when the mesh's winding is not to be trusted: the planes whose
+    normals lean disagree with the cameras on more area than they agree, as on a mesh wound inside out)
+    by the cameras: ``view_dirs`` (per face, summed directions to the cameras that saw it) when given and
+    not all zero, else towards ``cam_center``.
+
+    Why normals first: the cameras' mean position lies behind a piece standing free in the room that faces
+    a wall, and the cameras that saw a plane's faces can lie on both sides of it (a wall cabinet hung in a
+    galley, seen from behind over its top: its front plane was turned to the wall); the faces' normals
+    agree on the side the scan saw across the whole plane. Both sides of a thin board in one plane
+    cancel out; then the cameras decide. The walls, the largest planes, are seen from inside the room,
+    so on a mesh wound the right way most of the area agrees."""
+    cams, leans, areas = [], [], []
+    for p in planes:
+        a = area[p.faces]
+        leans.append(float((nrm[p.faces] @ p.n) @ a) / float(a.sum()) if a.sum() > 0 else 0.0)
+        areas.append(p.area)
+        toward = view_dirs[p.faces].sum(0) if view_dirs is not None else np.zeros(len(p.n))
+        if not np.any(toward):
+            toward = cam_center - p.to_world(np.mean(p.extent_u), np.mean(p.extent_v))
+        cams.append(1.0 if np.dot(p.n, toward) >= 0 else -1.0)
+    lean, cam, w = np.array(leans), np.array(cams), np.array(areas)
+    clear = (np.abs(lean) >= normal_agree) if normal_agree > 0 else np.zeros(len(planes), bool)
+    agree = clear & (np.sign(lean) == cam)
+    if w[agree].sum() < w[clear & ~agree].sum():
+        clear[:] = False
+    return np.where(clear, np.sign(lean), cam).tolist()
+
+
+def _explained(planes: list[Plane], cen: np.ndarray, cfg: PlanesConfig) -> np.ndarray:
+    """Faces a plane holds or that lie on one (within ``offset_tol`` of it, inside its extent grown by
+    ``cell``). Why the second: a TSDF wall's faces with normals beyond the angle tolerance (+-9 degrees of
+    noise, with tails) are still the wall; left to vote again, their many square metres pull the
+    direction of a turned piece's plane by several degrees towards the wall's."""
+    out = np.zeros(len(cen), bool)
+    for p in planes:
+        out[p.faces] = True
+        near = np.flatnonzero(np.abs(cen @ p.n - p.d) <= cfg.offset_tol)
+        uu, vv = cen[near] @ p.u, cen[near, 2]
+        inside = ((uu >= p.extent_u[0] - cfg.cell) & (uu <= p.extent_u[1] + cfg.cell)
+                  & (vv >= p.extent_v[0] - cfg.cell) & (vv <= p.extent_v[1] + cfg.cell))
+        out[near[inside]] = True
+    return out
+
+
+def _direction(n: np.ndarray) -> float:
+    """A horizontal normal's orientation-free direction in [0, 180) degrees."""
+    return float(np.degrees(np.arctan2(n[1], n[0])) % _HALF_TURN)
+
+
+def _vote(cand: np.ndarray, theta: np.ndarray, area: np.ndarray, cen: np.ndarray, samples: _Samples, cfg: PlanesConfig,
+          min_area: float, found: list[float]) -> tuple[list[Plane], list[float]]:
+    """Planes of the faces ``cand`` (bool per face; ``theta``: their normals' directions in degrees;
+    ``samples``: points spread over the vertical faces, for the refit and the pieces) by a
+    direction vote, then an offset vote per direction, and the direction peaks (degrees) that gave a plane.
+    Direction peaks closer than ``direction_min_sep_bins`` to one of ``found`` are not taken. A piece that is
+    a slice through a surface standing at another angle (``is_slice``: a turned cabinet's front cut along
+    a wall's direction) is left out, and its faces stay free for the next vote."""
+    angle_tol_deg, offset_tol, refit_deg = cfg.angle_tol_deg, cfg.offset_tol, cfg.refit_deg
+    if not cand.any():
+        return [], []
+    bins = np.floor(theta).astype(int) % _HALF_TURN_BINS
+    hist = np.bincount(bins[cand], weights=area[cand], minlength=_HALF_TURN_BINS)
+    hist = ndimage.uniform_filter1d(hist, cfg.direction_smooth_bins, mode="wrap")
+    peaks = np.array([k for k in _peaks(hist, min_area / cfg.direction_peak_div, cfg.direction_min_sep_bins, circular=True)
+                      if all(abs(_wrapped(np.array(k - f))) >= cfg.direction_min_sep_bins for f in found)], float)
+    planes: list[Plane] = []
+    if not len(peaks):
+        return [], []
+    # each face goes to its nearest direction peak (a cabinet turned by 9 degrees is its own plane)
+    dist = np.abs(_wrapped(theta[:, None] - peaks[None]))
+    nearest = dist.argmin(1)
+    voted: set[float] = set()
     for j, peak in enumerate(peaks):
         dth = _wrapped(theta - peak)
-        near = vert & (nearest == j) & (np.abs(dth) <= angle_tol_deg)
+        near = cand & (nearest == j) & (np.abs(dth) <= angle_tol_deg)
         if area[near].sum() < min_area:
             continue
         ang = np.radians(peak + np.average(dth[near], weights=area[near]))
@@ -144,20 +226,37 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
                 if area[sel].sum() < min_area:
                     continue
                 used[sel] = True
-            planes += _pieces(sel, samples, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])), cfg.cell,
-                              min_area)
-    # orient each plane's normal towards the cameras that see it
-    out = []
-    for p in planes:
-        if view_dirs is not None:
-            toward = view_dirs[p.faces].sum(0)
-        else:
-            toward = cam_center - p.to_world(np.mean(p.extent_u), np.mean(p.extent_v))
-        if np.dot(p.n, toward) < 0:
-            p = _flip(p)
-        out.append(p)
-    out.sort(key=lambda p: -p.area)
-    return out
+            for p in _pieces(sel, samples, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])), cfg.cell,
+                             min_area):
+                if cfg.max_skew_deg > 0 and is_slice(p, theta, area, cen, cfg.max_skew_deg):
+                    continue
+                planes.append(p)
+                voted.add(float(peak))
+    # the directions voted for, not the planes' own: a small plane refit a few degrees off its peak (a
+    # wall's strip behind a turned chest, 4 degrees off) would bar the direction the next vote needs
+    return planes, sorted(voted)
+
+
+def is_slice(p: Plane, theta: np.ndarray, area: np.ndarray, cen: np.ndarray, max_turn_deg: float) -> bool:
+    """Is the piece a slice cut through a surface turned from it, not a plane? Its faces' positions lie
+    on a line turned by more than ``max_turn_deg`` from the piece's direction (least squares of their
+    offsets against their place along it), and their normals (``theta``, degrees) lean the same way.
+
+    Why positions: the plane's faces are those whose normals lie within the angle tolerance, so on a
+    TSDF scan (normals spread by +-9 degrees) a front turned by 11 degrees shows only a 4-degree mean
+    lean, while the positions of a 25 cm slice through it turn by the full 11 degrees (a flat plane's
+    by under 2). Why both: two parallel layers a few cm apart within one short piece (a door beside
+    its carcass edge) tilt the fitted line too, but leave the normals straight."""
+    w, c = area[p.faces], cen[p.faces]
+    uu, off = c @ p.u, c @ p.n
+    du, do = uu - np.average(uu, weights=w), off - np.average(off, weights=w)
+    var = float(np.average(du ** 2, weights=w))
+    if var <= 0:
+        return False
+    # u = z x n, so a surface turned counter-clockwise (normal towards +u) has offsets falling along u
+    turn = -np.degrees(np.arctan(float(np.average(du * do, weights=w)) / var))
+    lean = float(np.average(_wrapped(theta[p.faces] - _direction(p.n)), weights=w))
+    return bool(abs(turn) > max_turn_deg and np.sign(lean) == np.sign(turn))
 
 
 def surface_samples(tri: np.ndarray, area: np.ndarray, spacing: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -3,7 +3,8 @@
 A scan is taken from inside a room, so nothing behind its outer walls is scanned. Cabinets stand in
 front of a wall: the wall above a base run, below wall cabinets or above a wardrobe, the floor running
 under a unit, lies behind their fronts' plane. A front whose plane has (almost) no scan surface more
-than ``depth`` behind it is therefore painted on an outer wall, and there the wall's paint, the seams
+than ``depth`` behind it is therefore painted on an outer wall (or hung on it: a radiator, a picture a few
+cm proud of the wall, whose wall within ``wall_band`` behind counts as its plane's), and there the wall's paint, the seams
 between views fused at different exposures, a skirting board or a light switch make cells and "handles"
 (on the tuning scenes 51 of 102 false fronts, and 0 of the true cabinet fronts, had nothing behind
 them). The only openable thing set into an outer wall is a room door — floor to door height, door
@@ -26,8 +27,9 @@ from .image_fronts import floor_level
 
 def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> list[bool]:
     """Per front: does its plane have less than ``behind_share`` of the scan's area more than ``depth``
-    behind it (the wall's own outer side, ``wall_back``, left out), with at least ``min_area`` of other surface in the plane (within ``plane_tol``, facing
-    the same way; see module docstring)?"""
+    behind it (the wall's own outer side, ``wall_back``, left out), with at least ``min_area`` of other
+    surface in the plane (within ``plane_tol``, facing the same way, or up to ``wall_band`` behind it; see
+    module docstring)?"""
     if not fronts:
         return []
     cen, area, nrm = mesh.face_centroids, mesh.face_areas, mesh.face_normals
@@ -41,7 +43,7 @@ def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> 
         # a modelled wall's own outer side is behind it, facing away: nothing a camera in the room saw
         own_back = (d > -rules.wall_back) & (nrm @ f.n_out < -rules.plane_min_cos)
         behind = float(area[(d < -rules.depth) & ~own_back].sum()) / total
-        wall = (np.abs(d) < rules.plane_tol) & (nrm @ f.n_out > rules.plane_min_cos) & ~in_front
+        wall = (d > -max(rules.plane_tol, rules.wall_band)) & (d < rules.plane_tol) & (nrm @ f.n_out > rules.plane_min_cos) & ~in_front
         out.append(behind < rules.behind_share and float(area[wall].sum()) >= rules.min_area)
     return out
 

@@ -58,7 +58,7 @@ def test_vertical_planes_split_l_shape_and_turned_cabinet() -> None:
     grey = lambda x, z: np.full((len(x), 3), 150, np.uint8)  # noqa: E731
     back = _grid_mesh(0.0, 2.0, 0.0, 0.9, 2.0, 0.02, grey)                       # n = -y, y = 2
     side = _grid_mesh(0.0, 1.5, 0.0, 0.9, 0.0, 0.02, grey)
-    side = TriMesh(side.vertices[:, [1, 0, 2]], side.faces[:, ::-1], side.colors)   # x = 0 plane, facing +x
+    side = TriMesh(side.vertices[:, [1, 0, 2]], side.faces, side.colors)   # x = 0 plane, facing +x (the swap mirrors)
     a = np.radians(9.0)
     unit = _grid_mesh(0.0, 0.8, 0.5, 1.0, 0.0, 0.02, grey)
     R = np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
@@ -681,6 +681,8 @@ def test_handle_less_fronts_reaching_the_floor_are_wall() -> None:
     wall, drawer, door = front(0.0, False), front(0.05, False), front(0.0, True)
     assert off_the_floor([wall, drawer, door], 0.001, 0.03) == [drawer, door]
     assert off_the_floor([wall, drawer, door], None, 0.03) == [wall, drawer, door]
+    # the bottom drawer of a handle-less stack reaches the floor too (a recessed plinth scanned with it)
+    assert off_the_floor([wall, drawer, door], 0.001, 0.03, {id(wall)}) == [wall, drawer, door]
 
 
 def _line_points(theta_deg: float, d: float, t0: float, t1: float, step: float = 0.01) -> np.ndarray:

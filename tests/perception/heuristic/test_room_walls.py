@@ -76,6 +76,19 @@ def test_behind_share_is_the_area_behind_over_the_whole_scan() -> None:
     assert on_outer_wall(f, near, rules) == [True]
 
 
+def test_a_radiator_hung_on_the_outer_wall_is_on_it() -> None:
+    """A 0.8 x 0.6 m radiator 8 cm proud of a 4 x 2.5 m outer wall, cut into 0.2 m "fronts": its own plane
+    holds only its 0.48 m² (under ``min_area``), but the wall 8 cm behind lies within ``wall_band`` and
+    nothing lies farther behind: on the wall. With the band at 0 the radiator stands alone, and stays.
+    A base unit's front 0.5 m before the wall is no such front (the wall lies farther behind it)."""
+    mesh = _mesh(_wall(0, 4, 3.0, 0, 2.5), _wall(1.0, 1.8, 2.92, 0.15, 0.75), _wall(2.5, 3.1, 2.5, 0.1, 0.85))
+    rads = [_front(1.0 + 0.2 * k, 1.2 + 0.2 * k, 0.15, 0.75, 2.92, faces=[2, 3] if k == 0 else []) for k in range(4)]
+    base = _front(2.5, 3.1, 0.1, 0.85, 2.5, faces=[4, 5])
+    assert on_outer_wall(rads + [base], mesh, RoomWallConfig()) == [True] * 4 + [False]
+    assert on_outer_wall(rads + [base], mesh, RoomWallConfig(wall_band=0.0)) == [False] * 5
+    assert keep_room_doors(rads + [base], mesh, RoomWallConfig(), FrontRulesConfig(), FloorConfig()) == [base]
+
+
 def test_a_lone_cabinet_scanned_from_the_front_is_no_wall() -> None:
     """Only the cabinet's two doors were scanned (nothing behind their plane, but no wall around them
     either: every face in the plane belongs to a front): both kept as they were."""
