@@ -15,6 +15,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import cv2
+import networkx as nx
 import numpy as np
 
 from ...config.heuristic import FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig
@@ -384,24 +385,10 @@ def stacks(fronts: list[Front], rules: FrontRulesConfig, n: int) -> set[int]:
     drawer-sized cells; its cells are wall-wide or door-tall."""
     if n <= 0:
         return set()
-    col = {id(f): [g for g, side in _neighbours(f, fronts, rules) if side == "vertical"] for f in fronts}
-    out: set[int] = set()
-    seen: set[int] = set()
-    for f in fronts:
-        if id(f) in seen:
-            continue
-        group, todo = [], [f]
-        seen.add(id(f))
-        while todo:
-            g = todo.pop()
-            group.append(g)
-            for h in col[id(g)]:
-                if id(h) not in seen:
-                    seen.add(id(h))
-                    todo.append(h)
-        if len(group) >= n:
-            out.update(id(g) for g in group)
-    return out
+    column = nx.Graph()
+    column.add_nodes_from(id(f) for f in fronts)
+    column.add_edges_from((id(f), id(g)) for f in fronts for g, side in _neighbours(f, fronts, rules) if side == "vertical")
+    return {k for group in nx.connected_components(column) if len(group) >= n for k in group}
 
 
 def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.ndarray | None:
