@@ -49,3 +49,6 @@ class ClipConfig(StageConfig):
     max_abs_nz: float = Field(0.7071, ge=0, le=1, description="Near-vertical points: |n_z| <= sin 45 deg.")
     keep_behind_m: float = Field(0.03, ge=0, description="Keep geometry up to this far behind the plane (slab thickness).")
     seed: int = Field(0, description="RANSAC seed.")
+    lid_min_area_m2: float = Field(0.15, ge=0, description="A part whose upward faces seen from above cover at least this area (m^2) and lid_ratio times its camera-facing vertical area is a lid: clipped to a horizontal plane (0: fronts only).")
+    lid_ratio: float = Field(3.0, gt=0, description="Upward against camera-facing vertical area that makes a part a lid.")
+    lid_max_tilt_deg: float = Field(15.0, ge=0, le=45, description="A face within this angle of pointing up counts towards a lid's top.")

@@ -3,6 +3,8 @@
 Why: a whole-object mask (door + carcass frame) back-projects onto the carcass sides and top too.
 The front of a door or drawer is the dominant near-vertical plane of the segmented mesh; geometry
 more than ``keep_behind_m`` behind it (seen from the segmenting view) is not part of the slab.
+A lid (a chest freezer's, a box's) is a horizontal front seen from above: clipped to a vertical plane it
+would keep only its lip, so a part whose top outweighs its vertical faces is clipped to its top's plane.
 """
 
 from __future__ import annotations
@@ -57,6 +59,25 @@ def ransac_plane(points: np.ndarray, weights: np.ndarray, config: ClipConfig, vi
     return n[best], float(d[best])
 
 
+def lid_plane(cen: np.ndarray, nrm: np.ndarray, area: np.ndarray, camera: np.ndarray, vertical_area: float,
+              config: ClipConfig) -> tuple[np.ndarray, float] | None:
+    """The horizontal plane of a lid's top (normal pointing down, into the object), or None for a front.
+
+    A lid is seen from above: its upward faces below the camera cover at least ``lid_min_area_m2`` and
+    ``lid_ratio`` times the camera-facing vertical faces (the lip, a front's face). The plane's height is
+    the area-weighted median of those faces', so a handle or lip does not pull it."""
+    if config.lid_min_area_m2 <= 0:
+        return None
+    up = (nrm[:, 2] >= np.cos(np.radians(config.lid_max_tilt_deg))) & (cen[:, 2] < camera[2])
+    a_up = float(area[up].sum())
+    if a_up < config.lid_min_area_m2 or a_up < config.lid_ratio * vertical_area:
+        return None
+    z, w = cen[up, 2], area[up]
+    order = np.argsort(z)
+    zc = float(z[order][np.searchsorted(np.cumsum(w[order]), 0.5 * a_up)])
+    return np.array([0.0, 0.0, -1.0]), zc
+
+
 def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, config: ClipConfig) -> tuple[np.ndarray, np.ndarray | None, float | None]:
     """Faces of the slab, and the plane (normal pointing away from the camera, offset) or None.
 
@@ -64,7 +85,7 @@ def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, co
     fewer than 3 do, e.g. for unoriented meshes).
 
     Faces whose centroid lies more than ``keep_behind_m`` behind the plane are dropped; everything in
-    front (handles) stays.
+    front (handles) stays. A lid (:func:`lid_plane`) is clipped to its top's horizontal plane instead.
     """
     face_ids = np.asarray(face_ids, np.int64)
     if not config.enabled or not len(face_ids):
@@ -74,6 +95,10 @@ def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, co
     facing = vert & (((np.asarray(camera_center, float) - cen) * nrm).sum(1) > 0)
     if facing.sum() >= 3:  # the front is what the camera sees: not the door's own back face
         vert = facing
+    lid = lid_plane(cen, nrm, area, np.asarray(camera_center, float), float(area[vert].sum()), config)
+    if lid is not None:
+        n, d = lid
+        return face_ids[cen @ n + d <= config.keep_behind_m], n, d
     if not vert.any():
         return face_ids, None, None
     foot = np.average(cen[vert], axis=0, weights=area[vert] + 1e-12)

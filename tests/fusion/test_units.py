@@ -260,3 +260,38 @@ def test_clip_keeps_front_slab_and_handle_drops_carcass():
     assert len(deep) and not (set(deep.tolist()) & kept)
     off, n0, _ = clip_part(mesh, np.arange(mesh.n_faces), np.zeros(3), ClipConfig(enabled=False))
     assert n0 is None and len(off) == mesh.n_faces
+
+
+def _horizontal(x0: float, x1: float, y0: float, y1: float, z: float, n: int) -> TriMesh:
+    """A grid in the plane z = const facing up."""
+    g = grid(x0, x1, y0, y1, z, n, n)
+    g.vertices = g.vertices[:, [0, 2, 1]].copy()  # swapping y and z mirrors the -y facing grid to face up
+    return g
+
+
+def test_clip_keeps_a_lid_by_its_top_plane():
+    # a chest freezer's lid seen from above: a 1.0 x 0.6 m top at z = 0.85 (0.6 m2), a 5 cm lip on its
+    # front edge, and 12 cm of the body below the lip the mask leaked onto
+    top = _horizontal(0.0, 1.0, -0.3, 0.3, 0.85, 10)
+    lip = grid(0.0, 1.0, 0.80, 0.85, -0.3, 10, 5)
+    body = grid(0.0, 1.0, 0.68, 0.80, -0.3, 10, 12)
+    mesh, (t, lp, b) = merge(top, lip, body)
+    assert (mesh.face_normals[t, 2] > 0.99).all()
+    cam = np.array([0.5, -1.5, 1.6])
+    keep, n, d = clip_part(mesh, np.arange(mesh.n_faces), cam, ClipConfig())
+    assert np.allclose(n, [0, 0, -1]) and d == pytest.approx(0.85)  # s = 0.85 - z: > 0 below the top
+    kept = set(keep.tolist())
+    cz = mesh.face_centroids[:, 2]
+    assert set(t.tolist()) <= kept
+    assert set(lp[cz[lp] >= 0.82].tolist()) <= kept and not (set(b.tolist()) & kept)  # 3 cm below the top stay
+    # the vertical rule would have kept the lip and body (the front plane y = -0.3) and dropped the top
+    keep_v, n_v, _ = clip_part(mesh, np.arange(mesh.n_faces), cam, ClipConfig(lid_min_area_m2=0))
+    assert abs(n_v[2]) < 1e-6 and not (set(t.tolist()) <= set(keep_v.tolist()))
+    # a top of 0.1 m2 is no lid (under lid_min_area_m2 = 0.15); nor is a top above the camera
+    small = merge(_horizontal(0.0, 0.5, -0.1, 0.1, 0.85, 10), lip, body)[0]
+    assert abs(clip_part(small, np.arange(small.n_faces), cam, ClipConfig())[1][2]) < 1e-6
+    below = clip_part(mesh, np.arange(mesh.n_faces), np.array([0.5, -1.5, 0.5]), ClipConfig())[1]
+    assert abs(below[2]) < 1e-6
+    # an upward area under lid_ratio times the vertical one is a front with something on top
+    tall = merge(top, grid(0.0, 1.0, 0.0, 0.85, -0.3, 10, 20))[0]  # 0.85 m2 of front below the 0.6 m2 top
+    assert abs(clip_part(tall, np.arange(tall.n_faces), cam, ClipConfig())[1][2]) < 1e-6
