@@ -269,6 +269,7 @@ class SeamConfig(StageConfig):
     min_line_cover: float = Field(0.3, ge=0, le=1, description="Straight seams and colour steps: lines less covered than this share of the best-covered line score 0.")
     noise_floor: float = Field(0.001, gt=0, description="Noise units of straight seams and colour steps are at least this (brightness / colour distance).")
     step_contrast: float = Field(0.25, ge=0, description="A colour step along a whole line (a door leaf in a pale wall) cuts when its colour distance is at least this ...")
+    ridges: bool = Field(True, description="In a cell holding no handle, a straight row brighter than the rows beside it (by dip_z noise units, in every piece: the same tests as a dark seam) is a seam too: the top edge of the drawer below, lit from above, which a handle-less chest shows between its drawers (vertical gaps catch no such light; a vertical bright line at a pedestal's lit side edge cut a 10 cm sliver off a drawer).")
     step_z: float = Field(15.0, ge=0, description="... and this many noise units of the cell's steps.")
     step_over_dip: bool = Field(True, description="A colour step along the whole cell that is stronger than the best dark line is the cut (a shaker frame casts a dark line inside its own edge).")
     between_z: float = Field(3.0, ge=0, description="Between two handles the cut is a straight seam of at least this many noise units ...")

@@ -389,6 +389,7 @@ DEFAULTS = {
     "perception.heuristic.seams.min_line_cover": 0.3,
     "perception.heuristic.seams.noise_floor": 0.001,
     "perception.heuristic.seams.step_contrast": 0.25,
+    "perception.heuristic.seams.ridges": True,
     "perception.heuristic.seams.step_z": 15.0,
     "perception.heuristic.seams.step_over_dip": True,
     "perception.heuristic.seams.between_z": 3.0,

@@ -6,9 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from react3d_core.config.heuristic import FrontRulesConfig
+from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
+from react3d_core.perception.heuristic.front_cells import split_cells
 from react3d_core.perception.heuristic.fronts import Front, _joint
 from react3d_core.perception.heuristic.image_fronts import piece_front, plain_fronts_kept, stacks
+from react3d_core.perception.heuristic.orthophoto import Orthophoto
+from react3d_core.perception.heuristic.planes import Plane
 
 N = np.array([0.0, -1.0, 0.0])      # facing -y; u = z x n = (1, 0, 0)
 U = np.array([1.0, 0.0, 0.0])
@@ -104,3 +107,32 @@ def test_a_tall_front_with_a_horizontal_bar_is_a_side_hinged_door() -> None:
     oven = _front(0.0, 0.6, 0.2, 0.8)
     kind, art = _joint(oven, bar(0.3, 0.72), [], FrontRulesConfig())
     assert kind == "drop" and abs(art.axis[0]) == 1.0
+
+
+def _ortho(img: np.ndarray, res: float = 0.004) -> Orthophoto:
+    """An orthophoto of plane y = 0 facing -y (u along x), every pixel seen by 5 views."""
+    h, w = img.shape[:2]
+    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
+                  (0.0, w * res), (0.0, h * res), w * h * res * res)
+    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+
+
+def test_bright_rows_cut_a_handle_less_chest_into_its_drawers() -> None:
+    """A handle-less chest front 0.6 x 0.42 m at 4 mm (150 x 105 px, grey 0.5 with noise) whose three
+    drawers are parted by 2 px rows brighter than the front (0.75: the lit top edge of the drawer below,
+    as a rendered TSDF chest shows them). No row is darker than its neighbours, so without ``seams.ridges``
+    the front stays one cell; with it the bright rows cut it into three drawers 35 px tall. A bright
+    vertical line is no seam (no light falls into a vertical gap): the cells stay 150 px wide."""
+    rng = np.random.default_rng(5)
+    img = 0.5 + rng.normal(0, 0.004, (105, 150, 3)).astype(np.float32)
+    img[34:36] = 0.75
+    img[69:71] = 0.75
+    img[:, 74:76] = 0.75
+    o = _ortho(img)
+    cov = np.ones(img.shape[:2], bool)
+    off = HeuristicConfig(seams={"ridges": False})
+    assert len(split_cells(o, cov, [], off)) == 1
+    cells = sorted(split_cells(o, cov, [], HeuristicConfig()), key=lambda c: c.r0)
+    assert len(cells) == 3
+    assert [c.c1 - c.c0 for c in cells] == [150, 150, 150]
+    assert [(c.r0, c.r1) for c in cells] == [(0, 34), (35, 69), (70, 105)]  # cut on the bright rows 34, 69
