@@ -1,6 +1,7 @@
 """Split a fused orthophoto of a vertical plane into front-sized cells, at seams and between handles.
 
-Seams are thin lines darker than both sides (the shadow in the gap between two fronts) or thin gaps
+Seams are thin lines darker than both sides (the shadow in the gap between two fronts), in a cell
+without handles also rows brighter than both sides (the lit top edge of the drawer below), or thin gaps
 in the mesh coverage; a seam must span most of the cell it splits (furniture is laid out in
 guillotine cuts: a run splits into columns, a column into drawers). Handles are compact elongated
 blobs whose colour differs from their surroundings (metal bars on paint). A cell still holding two

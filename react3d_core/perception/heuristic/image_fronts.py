@@ -3,8 +3,9 @@
 The mesh-only rules (fronts.py) need seams in the mesh; real scans have none. Here each large
 vertical plane of the mesh is photographed from all the views that see it (orthophoto.py), split at
 the seams and between the handles the photos show (front_cells.py), and every door/drawer-sized cell
-with a handle — or cut out by seams on at least two sides and not tile-sized — becomes a front whose
-faces are the plane's faces inside the cell. Joint type and hinge side come from the same rules as
+with a handle — or cut out by seams on at least two sides and not tile-sized, or on one side where the
+plane's outline closes it (``plain_fronts_kept``) — becomes a front whose faces are the plane's faces
+inside the cell. Joint type and hinge side come from the same rules as
 mesh fronts (handle position and shape, neighbours).
 """
 
