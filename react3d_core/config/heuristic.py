@@ -59,6 +59,7 @@ class FrontRulesConfig(StageConfig):
     drawer_max_h: float = Field(0.45, gt=0, description="Drawers are at most this tall (m): deep drawers reach ~0.45 m, oven/dishwasher doors are >= 0.5 m.")
     drawer_travel: float = Field(0.3, gt=0, description="A drawer's guessed travel (m): the upper limit of its prismatic joint.")
     flap_min_top: float = Field(1.2, ge=0, description="A top-hinged flap lifts upwards: its top is above this height (m, z up from the floor), above a worktop.")
+    flap_max_h: float = Field(1.2, gt=0, description="A top-hinged flap or a bottom-hinged drop door is at most this tall (m): a taller front with a horizontal bar (a fridge door, a tall cabinet door) is hinged at a side.")
     flap_max_deg: float = Field(90.0, gt=0, description="A flap's or drop door's guessed opening (deg).")
     door_max_deg: float = Field(100.0, gt=0, description="A side-hinged door's guessed opening (deg).")
     neighbour_gap: float = Field(0.03, ge=0, description="Coplanar fronts closer than this (m) are neighbours (door pairs, drawer stacks).")
@@ -268,6 +269,7 @@ class SeamConfig(StageConfig):
     min_line_cover: float = Field(0.3, ge=0, le=1, description="Straight seams and colour steps: lines less covered than this share of the best-covered line score 0.")
     noise_floor: float = Field(0.001, gt=0, description="Noise units of straight seams and colour steps are at least this (brightness / colour distance).")
     step_contrast: float = Field(0.25, ge=0, description="A colour step along a whole line (a door leaf in a pale wall) cuts when its colour distance is at least this ...")
+    ridges: bool = Field(True, description="In a cell holding no handle, a straight row brighter than the rows beside it (by dip_z noise units, in every piece: the same tests as a dark seam) is a seam too: the top edge of the drawer below, lit from above, which a handle-less chest shows between its drawers (vertical gaps catch no such light; a vertical bright line at a pedestal's lit side edge cut a 10 cm sliver off a drawer).")
     step_z: float = Field(15.0, ge=0, description="... and this many noise units of the cell's steps.")
     step_over_dip: bool = Field(True, description="A colour step along the whole cell that is stronger than the best dark line is the cut (a shaker frame casts a dark line inside its own edge).")
     between_z: float = Field(3.0, ge=0, description="Between two handles the cut is a straight seam of at least this many noise units ...")
@@ -333,6 +335,10 @@ class CellConfig(StageConfig):
     min_tile_side: float = Field(0.25, ge=0, description="Handle-less cells smaller than this both ways are tiles, not fronts (m).")
     handleless_min_seams: int = Field(2, ge=0, description="A handle-less cell cut out by this many straight seams (push-to-open fronts) is a front; 0: only beside a handled front.")
     stack_min: int = Field(3, ge=0, description="A handle-less cell in a column of at least this many door/drawer-sized cells stacked on one another, each as wide as the next (a drawer pedestal or chest with edge pulls or no handles), is a front; 0: off.")
+    single_cut: bool = Field(True, description="A handle-less cell cut on one side only (its other sides the plane's outline: the end of a row, the top drawer of a pedestal) is a front when it stands in a stack (stack_min), beside a front kept by the other rules (same rows or same columns), or on a piece's front (piece_max_w); off: such cells are never fronts.")
+    piece_max_w: float = Field(2.0, ge=0, description="A plane whose covered outline is at most this wide (m), at most fronts.max_h tall and filled to piece_fill, holding no front with a handle, is the front of one piece standing free (a fridge, a push-to-open cabinet): its handle-less cells cut on at least one side are its fronts; 0: off.")
+    piece_fill: float = Field(0.6, ge=0, le=1, description="... share of the covered outline's box the plane's surface covers (a front is a rectangle, its TSDF edges ragged: a fridge's 0.71; a wall behind furniture is a box with holes: 0.22-0.32 on appliance scene 308).")
+    mesh_split_seams: bool = Field(True, description="A mesh front holding two or more image fronts cut out by straight seams (cells.handleless_min_seams, on an untiled plane) is several fronts the mesh could not tell apart, as with two fronts with handles; off: only fronts with handles count.")
 
 
 class ClutterConfig(StageConfig):

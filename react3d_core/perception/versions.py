@@ -33,6 +33,11 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     plane explains vote again (planes.max_skew_deg, planes.revote_rounds); a plane faces the way its
 #     faces' normals point (planes.normal_agree); handle-less cells stacked in a column are fronts
 #     (cells.stack_min); chest lids (lids); surface within room_wall.wall_band behind a front is in its plane
-HEURISTIC_VERSION = "21"
+# 22: handle-less cells cut on one side only (row ends, a pedestal's top drawer) are fronts in a stack or
+#     beside a kept front (cells.single_cut); a small filled handle-less plane is a piece's front, its cut
+#     cells fronts (cells.piece_*); a mesh front holding two seam-cut image fronts is replaced by them
+#     (cells.mesh_split_seams); no flap or drop door is taller than fronts.flap_max_h; in a handle-less
+#     cell a straight bright row is a seam (seams.ridges)
+HEURISTIC_VERSION = "22"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -1,6 +1,7 @@
 """Split a fused orthophoto of a vertical plane into front-sized cells, at seams and between handles.
 
-Seams are thin lines darker than both sides (the shadow in the gap between two fronts) or thin gaps
+Seams are thin lines darker than both sides (the shadow in the gap between two fronts), in a cell
+without handles also rows brighter than both sides (the lit top edge of the drawer below), or thin gaps
 in the mesh coverage; a seam must span most of the cell it splits (furniture is laid out in
 guillotine cuts: a run splits into columns, a column into drawers). Handles are compact elongated
 blobs whose colour differs from their surroundings (metal bars on paint). A cell still holding two
@@ -482,6 +483,12 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
                     + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px))
     cv_, sc_v = _dip_cut(g[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
     ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
+    if p.ridges and not any(c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1 for h in handles):
+        # a handle-less cell: a straight row brighter than both sides along the whole cell is a seam too
+        # (the top edge of the drawer below, lit from above; a vertical gap catches no such light)
+        rh_, rs_h = _dip_cut(-g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
+        if rs_h > sc_h:
+            ch_, sc_h = rh_, rs_h
     sc_v = sc_v if sc_v >= p.dip_z else 0.0
     sc_h = sc_h if sc_h >= p.dip_z else 0.0
     dip_v, dip_h = sc_v > 0.0, sc_h > 0.0

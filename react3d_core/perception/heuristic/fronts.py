@@ -5,7 +5,8 @@ Rules (a heuristic, see docs/perception.md for its limits):
 - type: a horizontal handle on a low front (h <= ``drawer_max_h``) or a low handle-less front that is
   wide or stacked with a same-width front -> drawer (prismatic, pulled along the front normal); a
   horizontal handle low on a tall front ->
-  top-hinged flap; high on a tall front -> bottom-hinged drop door; otherwise a vertical hinge;
+  top-hinged flap; high on a tall front -> bottom-hinged drop door (neither taller than ``flap_max_h``);
+  otherwise a vertical hinge;
 - hinge side: opposite the handle; without a handle, away from an adjacent coplanar neighbour of the
   same height (door pairs), else the left edge.
 """
@@ -365,7 +366,8 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
     if (horizontal and f.h <= r.drawer_max_h) or (hpts is None and f.h <= r.drawer_max_h and (f.w >= f.h or stacked)):
         return "drawer", Articulation(joint_type="prismatic", axis=f.n_out, origin=centre, lower=0.0, upper=r.drawer_travel,
                                       limit_source="heuristic")
-    if horizontal and not (hcv < cv and f.extent_v[1] < r.flap_min_top):  # no flap lifts under a worktop
+    # no flap lifts under a worktop, and no front taller than a flap or drop door swings about a horizontal axis
+    if horizontal and f.h <= r.flap_max_h and not (hcv < cv and f.extent_v[1] < r.flap_min_top):
         low = hcv < cv
         edge_v = f.extent_v[1] if low else f.extent_v[0]  # flap: hinge on top; drop door: hinge at the bottom
         origin = on_plane(cu, edge_v)

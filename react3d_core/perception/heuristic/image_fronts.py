@@ -3,8 +3,9 @@
 The mesh-only rules (fronts.py) need seams in the mesh; real scans have none. Here each large
 vertical plane of the mesh is photographed from all the views that see it (orthophoto.py), split at
 the seams and between the handles the photos show (front_cells.py), and every door/drawer-sized cell
-with a handle — or cut out by seams on at least two sides and not tile-sized — becomes a front whose
-faces are the plane's faces inside the cell. Joint type and hinge side come from the same rules as
+with a handle — or cut out by seams on at least two sides and not tile-sized, or on one side where the
+plane's outline closes it (``plain_fronts_kept``) — becomes a front whose faces are the plane's faces
+inside the cell. Joint type and hinge side come from the same rules as
 mesh fronts (handle position and shape, neighbours).
 """
 
@@ -30,6 +31,7 @@ from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
 from .plane_surface import PlaneSurface, cast_surface, flat_surface
 from .planes import Plane, vertical_planes
 
+_MIN_CUT_SIDES = 2  # a handle-less cell cut out on this many sides is cut out by the plane's seams
 _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
 
 
@@ -312,6 +314,9 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     centroids = mesh.face_centroids
     fronts: list[Front] = []
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
+    singles: set[int] = set()  # handle-less fronts cut on one side only (the others: the plane's outline)
+    pieces: set[int] = set()  # handle-less fronts on the front of a piece standing free (``piece_front``)
+    one_cut = cfg.cells.single_cut or cfg.cells.piece_max_w > 0
     veto_evidence: list[VetoEvidence] = []
     for i, o in enumerate(orthos):
         if cfg.image.surface_rays:
@@ -349,33 +354,74 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None)
         tiled = any(max(c.c1 - c.c0, c.r1 - c.r0) * o.res < cfg.cells.min_tile_side
                     and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cfg.cells.min_seen for c in cells)
+        mine: list[Front] = []
         for cell in cells:
             f = _cell_front(o, cell, cov, clutter, in_plane, cfg, None,
-                            (thr, structure) if clut.cell_median else None)
+                            (thr, structure) if clut.cell_median else None, one_cut)
             if f is not None:
                 if f.handle_points is None:
                     f.shadow_points = _shadow_in_cell(o, cell, shadows)
-                fronts.append(f)
+                    if cell.cut_sides < _MIN_CUT_SIDES:
+                        singles.add(id(f))
+                mine.append(f)
                 if not tiled and 0 < cfg.cells.handleless_min_seams <= cell.seam_cuts:
                     gridded.add(id(f))
-    fronts, split_mesh = _settle_with_mesh_fronts(fronts, taken_faces, mesh_fronts, mesh.n_faces, cfg.image)
+        if (not tiled and all(f.handle_points is None for f in mine)
+                and piece_front(cov, o.res, cfg.cells.piece_max_w, rules.max_h, cfg.cells.piece_fill)):
+            pieces.update(id(f) for f in mine)
+        fronts += mine
+    if not cfg.cells.single_cut:
+        fronts = [f for f in fronts if id(f) not in singles or id(f) in pieces]
+    fronts, split_mesh = _settle_with_mesh_fronts(fronts, taken_faces, mesh_fronts, mesh.n_faces, cfg.image,
+                                                  gridded if cfg.cells.mesh_split_seams else set())
     # a handle-less cell is a front beside a front with a handle, or when straight seams along its whole
     # length cut it out on ``handleless_min_seams`` sides (push-to-open fronts), or in a column of
     # ``stack_min`` stacked cells of one width (a drawer pedestal with edge pulls); tiles and splash-backs
     # have no handles and, tiled, cells smaller than a front
     stacked = stacks(fronts, rules, cfg.cells.stack_min)
-    fronts = [f for f in fronts if f.handle_points is not None or id(f) in gridded or id(f) in stacked
-              or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules))]
+    fronts = plain_fronts_kept(fronts, rules, gridded, stacked, singles, pieces)
     # ... but a handle-less panel that reaches down to the floor is wall (beside a room door, say): base
-    # units stand on a plinth and room doors have handles; a stack's bottom drawer stays
+    # units stand on a plinth and room doors have handles; a stack's bottom drawer and a piece's fronts stay
     if cfg.image.plain_floor_gap > 0:
-        fronts = off_the_floor(fronts, floor_height(mesh, cfg.floor), cfg.image.plain_floor_gap, stacked)
+        fronts = off_the_floor(fronts, floor_height(mesh, cfg.floor), cfg.image.plain_floor_gap, stacked | pieces)
     for f in fronts:
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else f.shadow_points
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, veto_evidence, cfg)})
     return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
+
+
+def plain_fronts_kept(fronts: list[Front], rules: FrontRulesConfig, gridded: set[int], stacked: set[int],
+                      singles: set[int], pieces: set[int]) -> list[Front]:
+    """The fronts kept of ``fronts``: every one with a handle; a handle-less one cut out on two or more sides
+    when straight seams cut it out (``gridded``), it stands in a stack (``stacked``) or beside a front with a
+    handle; one cut on a single side (``singles``: its other sides are the plane's outline) when it stands in a
+    stack or beside a front kept so (same rows or same columns: the end of a row of doors, the top drawer of
+    a pedestal); and every one on the front of a piece standing free (``pieces``).
+
+    Why: a piece of furniture standing free ends where its plane ends, so its first and last fronts are cut
+    by one seam only; a wall run's ends are handled by the same rule, as a row of fronts reaches its end."""
+    def by_rules(f: Front) -> bool:
+        return (f.handle_points is not None or id(f) in gridded or id(f) in stacked
+                or any(g.handle_points is not None for g, _ in _neighbours(f, fronts, rules)))
+
+    base = {id(f) for f in fronts if id(f) not in singles and by_rules(f)}
+    row_ends = {id(f) for f in fronts if id(f) in singles and (id(f) in stacked or any(
+        id(g) in base for g, _ in _neighbours(f, fronts, rules)))}
+    keep = base | row_ends | pieces
+    return [f for f in fronts if id(f) in keep]
+
+
+def piece_front(cov: np.ndarray, res: float, max_w: float, max_h: float, fill: float) -> bool:
+    """Whether a plane's coverage ``cov`` (grid pixels of ``res`` m) is the front of one piece standing free:
+    its covered box at most ``max_w`` wide (0: never) and ``max_h`` tall, the surface filling ``fill`` of it.
+    A wall is wider, or, behind furniture, a box with holes."""
+    rows, cols = np.nonzero(cov)
+    if max_w <= 0 or not len(rows):
+        return False
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    return bool((c1 - c0) * res <= max_w and (r1 - r0) * res <= max_h and cov[r0:r1, c0:c1].mean() >= fill)
 
 
 def stacks(fronts: list[Front], rules: FrontRulesConfig, n: int) -> set[int]:
@@ -401,10 +447,11 @@ def _shadow_in_cell(o: Orthophoto, cell: Cell, shadows: Sequence[Handle]) -> np.
 
 
 def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh_fronts: Sequence[Front],
-                             n_faces: int, p: ImageConfig) -> tuple[list[Front], set[int]]:
+                             n_faces: int, p: ImageConfig, seamed: set[int] | frozenset[int] = frozenset()) -> tuple[list[Front], set[int]]:
     """Image fronts beside the fronts found on the mesh. A mesh front holding two or more image fronts
-    with handles is several fronts the mesh could not tell apart (a TSDF dresser is one facet): it is
-    replaced by them. Otherwise the mesh front stands: an image front lying mostly (> ``mesh_share``) on
+    with handles, or cut out by straight seams (ids in ``seamed``), is several fronts the mesh could not
+    tell apart (a TSDF dresser is one facet; a laser scan's seam between two drawers of a chest may be
+    too narrow for the mesh rules, while the photos show it): it is replaced by them. Otherwise the mesh front stands: an image front lying mostly (> ``mesh_share``) on
     its faces is dropped, and one touching it loses those faces (it keeps ``min_faces`` or goes). Returns
     the kept image fronts and the indices of the mesh fronts replaced."""
     if taken is None or not taken.any():
@@ -415,7 +462,7 @@ def _settle_with_mesh_fronts(fronts: list[Front], taken: np.ndarray | None, mesh
     held: dict[int, int] = {}
     for f in fronts:
         o = owner[f.faces]
-        if f.handle_points is not None and len(o):
+        if (f.handle_points is not None or id(f) in seamed) and len(o):
             k = int(np.bincount(o + 1).argmax()) - 1
             if k >= 0 and (o == k).mean() > 0.5:
                 held[k] = held.get(k, 0) + 1
@@ -510,8 +557,9 @@ def _clutter_share(o: Orthophoto, cell: Cell, clutter: np.ndarray, seen: np.ndar
 
 def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, in_plane: np.ndarray,
                 cfg: HeuristicConfig, taken: np.ndarray | None,
-                plain: tuple[float, np.ndarray] | None = None) -> Front | None:
-    """The front of one cell, or None when the cell is not door/drawer-like."""
+                plain: tuple[float, np.ndarray] | None = None, one_cut: bool = False) -> Front | None:
+    """The front of one cell, or None when the cell is not door/drawer-like. A handle-less cell needs cuts
+    on two sides, or with ``one_cut`` on one (kept later only by ``plain_fronts_kept``'s rules)."""
     rules, clut = cfg.fronts, cfg.clutter
     sub = cov[cell.r0:cell.r1, cell.c0:cell.c1]
     if sub.size == 0 or sub.mean() < cfg.cells.min_seen:
@@ -528,7 +576,7 @@ def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray,
     w, h = u_b - u_a, v_b - v_a
     if not (rules.min_w <= w <= rules.max_w and rules.min_h <= h <= rules.max_h):
         return None
-    if not cell.handles and (cell.cut_sides < 2 or max(w, h) < cfg.cells.min_tile_side):
+    if not cell.handles and (cell.cut_sides < (1 if one_cut else _MIN_CUT_SIDES) or max(w, h) < cfg.cells.min_tile_side):
         return None  # a plain panel or a tile: not openable by these rules
     p = o.plane
     du, dv, dn = in_plane[:, 0], in_plane[:, 1], in_plane[:, 2]
