@@ -33,6 +33,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     plane explains vote again (planes.max_skew_deg, planes.revote_rounds); a plane faces the way its
 #     faces' normals point (planes.normal_agree); handle-less cells stacked in a column are fronts
 #     (cells.stack_min); chest lids (lids); surface within room_wall.wall_band behind a front is in its plane
-HEURISTIC_VERSION = "21"
+# 22: glass panes are on by default (image.pane_frame), pane-sized only (image.pane_min_side: handle shadows
+#     are no panes), sought again with the panes found counted as frame and closed over shelf edges
+#     (image.pane_rounds, image.pane_bar), and painted their frame's colour (image.pane_fill, image.pane_edge)
+HEURISTIC_VERSION = "22"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
