@@ -163,6 +163,7 @@ class ImageConfig(StageConfig):
     pane_frame_cover: float = Field(0.9, ge=0, le=1, description="... framed: this share of the band of width pane_frame around the hole is covered ...")
     pane_min_area: float = Field(0.01, ge=0, description="... the hole is at least this large (m²) ...")
     pane_min_side: float = Field(0.1, ge=0, description="... and its bounding box at least this wide and tall (m): a handle's scanning shadow on a TSDF front is a hole framed all round by the front, 2-6 cm wide (filled, held-apart TSDF kitchen 200 lost fronts: F1@0.5 0.84 -> 0.47).")
+    pane_min_fill: float = Field(0.8, ge=0, le=1, description="... and it fills at least this share of its bounding box (a pane is a rectangle cut to its frame: 0.90-1.00 on the glass tuning scenes; the scanning shadows of bar handles on TSDF drawers are ragged blobs, 0.27-0.65).")
     pane_rounds: int = Field(3, ge=1, description="Framed panes are sought this many times, each time with the panes found so far counted as frame (a shelf seen through a pane splits it into two holes).")
     pane_bar: float = Field(0.02, ge=0, description="Panes are closed over this (m): a shelf edge seen through a pane, or a glazing bar, between two panes is part of the door, not a seam.")
     pane_fill: bool = Field(True, description="A pane takes the median colour of the frame around it and counts as seen (off: it stays without colour, and seams through glass doors are judged on their rails alone).")

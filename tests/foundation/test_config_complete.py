@@ -308,6 +308,7 @@ DEFAULTS = {
     "perception.heuristic.image.pane_frame_cover": 0.9,
     "perception.heuristic.image.pane_min_area": 0.01,
     "perception.heuristic.image.pane_min_side": 0.1,
+    "perception.heuristic.image.pane_min_fill": 0.8,
     "perception.heuristic.image.pane_rounds": 3,
     "perception.heuristic.image.pane_bar": 0.02,
     "perception.heuristic.image.pane_fill": True,

@@ -151,7 +151,7 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
 
 
 def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float, rounds: int = 1,
-                 min_side: float = 0.0, bar: float = 0.0) -> np.ndarray:
+                 min_side: float = 0.0, bar: float = 0.0, min_fill: float = 0.0) -> np.ndarray:
     """``_framed_holes`` taken ``rounds`` times, each round on the coverage with the panes found so far
     filled, then closed over ``bar`` (m).
 
@@ -161,7 +161,7 @@ def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_ar
     door would be read as a seam between two fronts."""
     out = np.zeros(cov.shape, bool)
     for _ in range(max(1, rounds)):
-        new = _framed_holes(cov | out, res, frame, cover, min_area, min_side)
+        new = _framed_holes(cov | out, res, frame, cover, min_area, min_side, min_fill)
         if not new.any():
             break
         out |= new
@@ -172,14 +172,17 @@ def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_ar
 
 
 def _framed_holes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float,
-                  min_side: float = 0.0) -> np.ndarray:
+                  min_side: float = 0.0, min_fill: float = 0.0) -> np.ndarray:
     """Holes in a plane's coverage ``cov`` framed all round by the plane's surface: each hole (8-connected,
-    not touching the grid's border) of at least ``min_area`` m² whose ``frame`` m wide band around it is
-    covered by at least ``cover``.
+    not touching the grid's border) of at least ``min_area`` m², whose bounding box is ``min_side`` m both
+    ways and at least ``min_fill`` full, and whose ``frame`` m wide band around it is covered by at least
+    ``cover``.
 
     Why: a glass-panel door is a frame around a pane the scan mostly lacks (the sensor sees through it),
     so on its plane it is a ring; the door spans the ring and the pane. A gap between two fronts or an
-    open shelf beside a front is no hole framed all round by a door-frame wide band of surface."""
+    open shelf beside a front is no hole framed all round by a door-frame wide band of surface. A
+    handle's scanning shadow on a TSDF front is framed all round too, but narrow or ragged; a pane is a
+    rectangle cut to its frame."""
     out = np.zeros(cov.shape, bool)
     r = int(round(frame / res))
     if frame <= 0 or r < 1 or not cov.any():
@@ -189,7 +192,8 @@ def _framed_holes(cov: np.ndarray, res: float, frame: float, cover: float, min_a
     h, w = cov.shape
     x, y, bw, bh, area = (stats[:, k] for k in (cv2.CC_STAT_LEFT, cv2.CC_STAT_TOP, cv2.CC_STAT_WIDTH,
                                                  cv2.CC_STAT_HEIGHT, cv2.CC_STAT_AREA))
-    cand = np.flatnonzero((area * res ** 2 >= min_area) & (np.minimum(bw, bh) * res >= min_side) & (x > 0) & (y > 0) & (x + bw < w) & (y + bh < h))
+    cand = np.flatnonzero((area * res ** 2 >= min_area) & (np.minimum(bw, bh) * res >= min_side)
+                      & (area >= min_fill * bw * bh) & (x > 0) & (y > 0) & (x + bw < w) & (y + bh < h))
     kern = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
     for k in cand[cand > 0]:  # label 0: the covered pixels
         y0, y1, x0, x1 = max(y[k] - r, 0), min(y[k] + bh[k] + r, h), max(x[k] - r, 0), min(x[k] + bw[k] + r, w)
@@ -220,7 +224,7 @@ def fill_panes(o: Orthophoto, panes: np.ndarray, frame: float, gap: float) -> No
         pad = g + r + 1
         y0, y1, x0, x1 = max(y - pad, 0), min(y + bh + pad, h), max(x - pad, 0), min(x + bw + pad, w)
         me = lab[y0:y1, x0:x1] == k
-        dist = cv2.distanceTransform((~me).astype(np.uint8), cv2.DIST_L2, 3)
+        dist = cv2.distanceTransform((~me).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_3)
         band = (dist > g) & (dist <= g + r) & seen[y0:y1, x0:x1]
         if band.any():
             o.color[y0:y1, x0:x1][me] = np.median(o.color[y0:y1, x0:x1][band], axis=0)
@@ -374,7 +378,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
             cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
         panes = framed_panes(cov, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
-                             cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar)
+                             cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
+                             cfg.image.pane_min_fill)
         if panes.any():
             cov = cov | panes
             if cfg.image.pane_fill:

@@ -94,3 +94,14 @@ def test_a_pane_is_painted_its_frames_colour_past_the_shaded_edge_and_counts_as_
     o, sl = ortho()
     fill_panes(o, panes, frame=0.035, gap=0.0)  # read right at the pane: the shaded edge wins the median
     assert np.allclose(o.color[sl], (0.2, 0.2, 0.2))
+
+
+def test_a_ragged_framed_hole_is_no_pane():
+    # a bar handle's scanning shadow on a TSDF drawer: 20 x 12 cm across, framed all round, but a blob
+    cov, sl = grid_with_hole(rim_px=40, hole=(30, 50))
+    cov[60:75, 100:125] = True  # a quarter of its box is surface again ...
+    cov[80:90, 135:150] = True  # ... and a bite out of the other side: 65 % of the box is hole
+    assert framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1).any()  # without the fill test: a pane
+    assert not framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8).any()
+    cov, sl = grid_with_hole(rim_px=15)
+    assert framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8)[sl].all()  # a rectangle stays one
