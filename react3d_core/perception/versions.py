@@ -38,6 +38,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     cells fronts (cells.piece_*); a mesh front holding two seam-cut image fronts is replaced by them
 #     (cells.mesh_split_seams); no flap or drop door is taller than fronts.flap_max_h; in a handle-less
 #     cell a straight bright row is a seam (seams.ridges)
-HEURISTIC_VERSION = "22"
+# 23: glass panes are on by default (image.pane_frame), pane-sized only (image.pane_min_side: handle shadows
+#     are no panes), sought again with the panes found counted as frame and closed over shelf edges
+#     (image.pane_rounds, image.pane_bar), and painted their frame's colour (image.pane_fill, image.pane_edge)
+HEURISTIC_VERSION = "23"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -152,14 +152,39 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
     return keep[lab]
 
 
-def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float) -> np.ndarray:
+def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float, rounds: int = 1,
+                 min_side: float = 0.0, bar: float = 0.0, min_fill: float = 0.0) -> np.ndarray:
+    """``_framed_holes`` taken ``rounds`` times, each round on the coverage with the panes found so far
+    filled, then closed over ``bar`` (m).
+
+    Why: a shelf seen through a pane splits it into two holes, and the frame of each runs partly along
+    the other; once one is a pane, the other is framed too. The shelf's edge (or a glazing bar) left
+    between them belongs to the door as much as the panes do: a strip of another colour across the
+    door would be read as a seam between two fronts."""
+    out = np.zeros(cov.shape, bool)
+    for _ in range(max(1, rounds)):
+        new = _framed_holes(cov | out, res, frame, cover, min_area, min_side, min_fill)
+        if not new.any():
+            break
+        out |= new
+    k = int(round(bar / res))
+    if k >= 1 and out.any():
+        out |= cv2.morphologyEx(out.astype(np.uint8), cv2.MORPH_CLOSE, np.ones((2 * k + 1, 2 * k + 1), np.uint8)).astype(bool)
+    return out
+
+
+def _framed_holes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float,
+                  min_side: float = 0.0, min_fill: float = 0.0) -> np.ndarray:
     """Holes in a plane's coverage ``cov`` framed all round by the plane's surface: each hole (8-connected,
-    not touching the grid's border) of at least ``min_area`` m² whose ``frame`` m wide band around it is
-    covered by at least ``cover``.
+    not touching the grid's border) of at least ``min_area`` m², whose bounding box is ``min_side`` m both
+    ways and at least ``min_fill`` full, and whose ``frame`` m wide band around it is covered by at least
+    ``cover``.
 
     Why: a glass-panel door is a frame around a pane the scan mostly lacks (the sensor sees through it),
     so on its plane it is a ring; the door spans the ring and the pane. A gap between two fronts or an
-    open shelf beside a front is no hole framed all round by a door-frame wide band of surface."""
+    open shelf beside a front is no hole framed all round by a door-frame wide band of surface. A
+    handle's scanning shadow on a TSDF front is framed all round too, but narrow or ragged; a pane is a
+    rectangle cut to its frame."""
     out = np.zeros(cov.shape, bool)
     r = int(round(frame / res))
     if frame <= 0 or r < 1 or not cov.any():
@@ -169,7 +194,8 @@ def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_ar
     h, w = cov.shape
     x, y, bw, bh, area = (stats[:, k] for k in (cv2.CC_STAT_LEFT, cv2.CC_STAT_TOP, cv2.CC_STAT_WIDTH,
                                                  cv2.CC_STAT_HEIGHT, cv2.CC_STAT_AREA))
-    cand = np.flatnonzero((area * res ** 2 >= min_area) & (x > 0) & (y > 0) & (x + bw < w) & (y + bh < h))
+    cand = np.flatnonzero((area * res ** 2 >= min_area) & (np.minimum(bw, bh) * res >= min_side)
+                      & (area >= min_fill * bw * bh) & (x > 0) & (y > 0) & (x + bw < w) & (y + bh < h))
     kern = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * r + 1, 2 * r + 1))
     for k in cand[cand > 0]:  # label 0: the covered pixels
         y0, y1, x0, x1 = max(y[k] - r, 0), min(y[k] + bh[k] + r, h), max(x[k] - r, 0), min(x[k] + bw[k] + r, w)
@@ -178,6 +204,33 @@ def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_ar
         if band.any() and cov[y0:y1, x0:x1][band].mean() >= cover:
             out[y0:y1, x0:x1] |= me.astype(bool)
     return out
+
+
+def fill_panes(o: Orthophoto, panes: np.ndarray, frame: float, gap: float) -> None:
+    """Give each pane of ``panes`` the median colour of the frame around it and count it as seen, in
+    place: the seen pixels between ``gap`` and ``gap + frame`` (m) from the pane.
+
+    Why: the views see through a pane to the shelves behind it, and the plane's colour there is none;
+    left unseen, the lines through a glass door hold only its rails, so the seams between doors were
+    judged on a few pixels and the splitter cut doors at the panes' edges. A door's face is its frame;
+    painted its colour, the pane reads as more of it. The pane's own edge is left out of the median (the
+    frame's inner edge and the putty are shaded, and with them the painted pane was a darker panel whose
+    outline out-scored the seams beside it)."""
+    g = max(0, int(round(gap / o.res)))
+    r = max(1, int(round(frame / o.res)))
+    seen = o.n_views > 0
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(panes.astype(np.uint8), connectivity=CONNECTIVITY)
+    h, w = panes.shape
+    for k in range(1, n):
+        x, y, bw, bh = (int(stats[k, q]) for q in (cv2.CC_STAT_LEFT, cv2.CC_STAT_TOP, cv2.CC_STAT_WIDTH, cv2.CC_STAT_HEIGHT))
+        pad = g + r + 1
+        y0, y1, x0, x1 = max(y - pad, 0), min(y + bh + pad, h), max(x - pad, 0), min(x + bw + pad, w)
+        me = lab[y0:y1, x0:x1] == k
+        dist = cv2.distanceTransform((~me).astype(np.uint8), cv2.DIST_L2, cv2.DIST_MASK_3)
+        band = (dist > g) & (dist <= g + r) & seen[y0:y1, x0:x1]
+        if band.any():
+            o.color[y0:y1, x0:x1][me] = np.median(o.color[y0:y1, x0:x1][band], axis=0)
+            o.n_views[y0:y1, x0:x1][me] = max(1, int(np.median(o.n_views[y0:y1, x0:x1][band])))
 
 
 def cov_outline(cov: np.ndarray, px: int) -> np.ndarray:
@@ -329,7 +382,13 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         else:
             cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
-        cov = cov | framed_panes(cov, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area)
+        panes = framed_panes(cov, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
+                             cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
+                             cfg.image.pane_min_fill)
+        if panes.any():
+            cov = cov | panes
+            if cfg.image.pane_fill:
+                fill_panes(o, panes, cfg.image.pane_frame, cfg.image.pane_edge)
         diff = off_background(o, hc)
         outline = cov_outline(cov, cfg.image.outline_fill_px)  # handle shadows are holes in the plane, not its outline
         win = hc.background_win if hc.protrusion_from_surface else 0.0

@@ -43,3 +43,65 @@ def test_narrow_rims_small_holes_open_gaps_and_off_are_not_panes():
     assert not framed_panes(cov, RES, 0.035, 0.9, 0.01).any()
     cov, _ = grid_with_hole(rim_px=15)
     assert not framed_panes(cov, RES, 0.0, 0.9, 0.01).any()  # frame 0: off
+
+
+def test_a_handle_shadow_framed_by_its_front_is_no_pane():
+    # a TSDF front with a vertical bar's scanning shadow: a 2.4 x 20 cm hole, the front all round it
+    cov, sl = grid_with_hole(rim_px=40, hole=(50, 6))
+    assert framed_panes(cov, RES, 0.035, 0.9, 0.0).any()  # framed all round: without a pane size it was filled
+    assert not framed_panes(cov, RES, 0.035, 0.9, 0.0, min_side=0.1).any()
+    cov, sl = grid_with_hole(rim_px=15)  # a 16 x 24 cm pane stays one
+    assert framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1)[sl].all()
+
+
+def test_a_pane_split_by_a_shelf_seen_through_it_is_one_pane_with_the_shelf_edge():
+    cov, sl = grid_with_hole(rim_px=15, hole=(100, 60))  # a 40 x 24 cm pane (rows 60-160, cols 100-160) ...
+    cov[140:145, 100:160] = True  # ... a shelf's edge 2 cm tall across it, 6 cm above its bottom rail
+    upper, lower, shelf = (slice(60, 140), sl[1]), (slice(145, 160), sl[1]), (slice(140, 145), sl[1])
+    one = framed_panes(cov, RES, 0.035, 0.9, 0.01)
+    # the upper hole's band is 91 % covered (the shelf edge and the rails), the lower's only 86 %
+    assert one[upper].all() and not one[lower].any()
+    three = framed_panes(cov, RES, 0.035, 0.9, 0.01, rounds=3)
+    assert three[upper].all() and three[lower].all() and not three[shelf].any()
+    closed = framed_panes(cov, RES, 0.035, 0.9, 0.01, rounds=3, bar=0.02)
+    want = np.zeros_like(cov)
+    want[sl] = True
+    assert np.array_equal(closed, want)  # the shelf's edge is part of the door; the frame is not a pane
+
+
+def test_a_pane_is_painted_its_frames_colour_past_the_shaded_edge_and_counts_as_seen():
+    from react3d_core.perception.heuristic.image_fronts import fill_panes
+    from react3d_core.perception.heuristic.orthophoto import Orthophoto
+
+    def ortho() -> Orthophoto:
+        cov, sl = grid_with_hole(rim_px=20)
+        color = np.zeros(cov.shape + (3,), np.float32)
+        color[cov] = (0.6, 0.5, 0.4)  # the frame
+        edge = np.zeros_like(cov)
+        edge[55:105, 95:165] = True
+        edge[sl] = False
+        color[edge] = (0.2, 0.2, 0.2)  # its inner edge, 5 px (2 cm), shaded
+        return Orthophoto(plane=None, color=color, n_views=np.where(cov, 4, 0).astype(np.int32),
+                          u0=0.0, v_top=0.0, res=RES), sl
+
+    o, sl = ortho()
+    before = o.color.copy()
+    panes = np.zeros(o.n_views.shape, bool)
+    panes[sl] = True
+    fill_panes(o, panes, frame=0.035, gap=0.02)
+    assert np.allclose(o.color[sl], (0.6, 0.5, 0.4)) and (o.n_views[sl] == 4).all()
+    assert np.array_equal(o.color[~panes], before[~panes])  # nothing else changes
+    o, sl = ortho()
+    fill_panes(o, panes, frame=0.035, gap=0.0)  # read right at the pane: the shaded edge wins the median
+    assert np.allclose(o.color[sl], (0.2, 0.2, 0.2))
+
+
+def test_a_ragged_framed_hole_is_no_pane():
+    # a bar handle's scanning shadow on a TSDF drawer: 20 x 12 cm across, framed all round, but a blob
+    cov, sl = grid_with_hole(rim_px=40, hole=(30, 50))
+    cov[60:75, 100:125] = True  # a quarter of its box is surface again ...
+    cov[80:90, 135:150] = True  # ... and a bite out of the other side: 65 % of the box is hole
+    assert framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1).any()  # without the fill test: a pane
+    assert not framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8).any()
+    cov, sl = grid_with_hole(rim_px=15)
+    assert framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8)[sl].all()  # a rectangle stays one
