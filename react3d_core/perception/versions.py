@@ -33,6 +33,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     plane explains vote again (planes.max_skew_deg, planes.revote_rounds); a plane faces the way its
 #     faces' normals point (planes.normal_agree); handle-less cells stacked in a column are fronts
 #     (cells.stack_min); chest lids (lids); surface within room_wall.wall_band behind a front is in its plane
-HEURISTIC_VERSION = "21"
+# 22: a plane whose faces are coarser than image.rays_face_edge (a decimated scan) reads its coverage and
+#     handles from rays cast along its normal, not from its faces' centroids
+HEURISTIC_VERSION = "22"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
