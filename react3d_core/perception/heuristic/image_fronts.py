@@ -81,11 +81,36 @@ def off_the_floor(fronts: list[Front], floor: float | None, gap: float, stacked:
     return [f for f in fronts if f.handle_points is not None or f.extent_v[0] > floor + gap or id(f) in keep]
 
 
+EXACT_NORMAL = 3e-4
+"""Normals equal to this (about 0.02 degrees) are one modelled surface's: a scan's faces, fused from noisy
+depth and decimated or not, never share a normal to this precision over a plane."""
+
+
+MODELLED_GROUP = 0.01
+"""A group of faces with one exact normal counts towards a modelled plane from this share of its area."""
+
+
+def modelled_surface(mesh: TriMesh, faces: np.ndarray, share: float) -> bool:
+    """Whether at least ``share`` of the faces' area lies in groups of two or more faces with one exact
+    normal (``EXACT_NORMAL``), each group holding 1 % of the area or more: a modelled scene's plane (CAD, a
+    synthetic generator's clean mesh: flat fields, frames and panels each one normal), not a scan's, whose
+    faces almost never share a normal to that precision (0: never)."""
+    if share <= 0 or not len(faces):
+        return False
+    a = mesh.face_areas[faces]
+    key = np.round(mesh.face_normals[faces] / EXACT_NORMAL).astype(np.int64)
+    _, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    counts, areas = np.bincount(inv), np.bincount(inv, a)
+    shared = (counts >= 2) & (areas >= MODELLED_GROUP * a.sum())
+    return bool(areas[shared].sum() >= share * a.sum())
+
+
 def coarse_faces(mesh: TriMesh, faces: np.ndarray, edge: float) -> bool:
-    """Whether a plane's faces are too coarse for their centroids to paint it: the area-weighted median
-    of their size (sqrt(2 * area), a right triangle's leg) exceeds ``edge`` m (0: never). A fused scan's
-    1 cm faces are painted by centroids closed over ``image.coverage_close``; a decimated scan's 2-5 cm
-    faces leave most of a plane unpainted, so its coverage and handles are read from rays instead."""
+    """Whether a plane's faces are too coarse for their centroids to paint it: the area-weighted median of
+    their size (sqrt(2 * area), a right triangle's leg) exceeds ``edge`` m (0: never). A fused scan's 1 cm
+    faces are painted by centroids closed over ``image.coverage_close``; a decimated scan's 2-5 cm faces
+    leave most of a plane unpainted, so its coverage and handles are read from rays instead."""
     if edge <= 0 or not len(faces):
         return False
     a = mesh.face_areas[faces]
@@ -328,7 +353,10 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     veto_evidence: list[VetoEvidence] = []
     for i, o in enumerate(orthos):
-        rays = cfg.image.surface_rays or coarse_faces(mesh, o.plane.faces, cfg.image.rays_face_edge)
+        # a modelled scene's fronts are a few large triangles cut apart by exact seams: the mesh rules read
+        # those, and rays reading the whole of them cut panels and bevels into false cells
+        rays = cfg.image.surface_rays or (coarse_faces(mesh, o.plane.faces, cfg.image.rays_face_edge)
+                                          and not modelled_surface(mesh, o.plane.faces, cfg.image.modelled_share))
         if rays:
             surf = cast_surface(o.grid_points(), o.plane.n, raster, cfg.planes.offset_tol, hc.protrusion_depth[1],
                                 cfg.planes.offset_tol)
