@@ -41,6 +41,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 23: glass panes are on by default (image.pane_frame), pane-sized only (image.pane_min_side: handle shadows
 #     are no panes), sought again with the panes found counted as frame and closed over shelf edges
 #     (image.pane_rounds, image.pane_bar), and painted their frame's colour (image.pane_fill, image.pane_edge)
-HEURISTIC_VERSION = "23"
+# 24: a scan's plane whose faces are coarser than image.rays_face_edge (a decimated scan; not a modelled
+#     plane, image.modelled_share) reads its coverage and handles from rays, not its faces' centroids
+HEURISTIC_VERSION = "24"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

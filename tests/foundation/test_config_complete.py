@@ -302,6 +302,8 @@ DEFAULTS = {
     "perception.heuristic.image.face_depth": (-0.02, 0.07),
     "perception.heuristic.image.surface_rays": False,
     "perception.heuristic.image.seen_reach": 0.05,
+    "perception.heuristic.image.rays_face_edge": 0.015,
+    "perception.heuristic.image.modelled_share": 0.5,
     "perception.heuristic.image.coverage_close": 0.02,
     "perception.heuristic.image.outline_fill_px": 20,
     "perception.heuristic.image.min_faces": 4,

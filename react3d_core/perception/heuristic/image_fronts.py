@@ -83,6 +83,45 @@ def off_the_floor(fronts: list[Front], floor: float | None, gap: float, stacked:
     return [f for f in fronts if f.handle_points is not None or f.extent_v[0] > floor + gap or id(f) in keep]
 
 
+EXACT_NORMAL = 3e-4
+"""Normals equal to this (about 0.02 degrees) are one modelled surface's: a scan's faces, fused from noisy
+depth and decimated or not, never share a normal to this precision over a plane."""
+
+
+MODELLED_GROUP = 0.01
+"""A group of faces with one exact normal counts towards a modelled plane from this share of its area."""
+
+
+def modelled_surface(mesh: TriMesh, faces: np.ndarray, share: float) -> bool:
+    """Whether at least ``share`` of the faces' area lies in groups of two or more faces with one exact
+    normal (``EXACT_NORMAL``), each group holding 1 % of the area or more: a modelled scene's plane (CAD, a
+    synthetic generator's clean mesh: flat fields, frames and panels each one normal), not a scan's, whose
+    faces almost never share a normal to that precision (0: never)."""
+    if share <= 0 or not len(faces):
+        return False
+    a = mesh.face_areas[faces]
+    key = np.round(mesh.face_normals[faces] / EXACT_NORMAL).astype(np.int64)
+    _, inv = np.unique(key, axis=0, return_inverse=True)
+    inv = inv.ravel()
+    counts, areas = np.bincount(inv), np.bincount(inv, a)
+    shared = (counts >= 2) & (areas >= MODELLED_GROUP * a.sum())
+    return bool(areas[shared].sum() >= share * a.sum())
+
+
+def coarse_faces(mesh: TriMesh, faces: np.ndarray, edge: float) -> bool:
+    """Whether a plane's faces are too coarse for their centroids to paint it: the area-weighted median of
+    their size (sqrt(2 * area), a right triangle's leg) exceeds ``edge`` m (0: never). A fused scan's 1 cm
+    faces are painted by centroids closed over ``image.coverage_close``; a decimated scan's 2-5 cm faces
+    leave most of a plane unpainted, so its coverage and handles are read from rays instead."""
+    if edge <= 0 or not len(faces):
+        return False
+    a = mesh.face_areas[faces]
+    size = np.sqrt(2.0 * a)
+    order = np.argsort(size)
+    half = np.searchsorted(np.cumsum(a[order]), 0.5 * a.sum())
+    return bool(size[order][min(half, len(order) - 1)] > edge)
+
+
 def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) -> np.ndarray:
     """Grid pixels covered by the plane's own faces (centroids splatted, holes up to ``close`` m closed,
     fragments under ``min_area`` m² dropped): ``image.surface_rays`` off. Decimated scans' faces lie
@@ -372,7 +411,11 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     one_cut = cfg.cells.single_cut or cfg.cells.piece_max_w > 0
     veto_evidence: list[VetoEvidence] = []
     for i, o in enumerate(orthos):
-        if cfg.image.surface_rays:
+        # a modelled scene's fronts are a few large triangles cut apart by exact seams: the mesh rules read
+        # those, and rays reading the whole of them cut panels and bevels into false cells
+        rays = cfg.image.surface_rays or (coarse_faces(mesh, o.plane.faces, cfg.image.rays_face_edge)
+                                          and not modelled_surface(mesh, o.plane.faces, cfg.image.modelled_share))
+        if rays:
             surf = cast_surface(o.grid_points(), o.plane.n, raster, cfg.planes.offset_tol, hc.protrusion_depth[1],
                                 cfg.planes.offset_tol)
             flat = flat_surface(surf.offset, o.res, cfg.planes.slope_win, cfg.planes.angle_tol_deg)
@@ -392,7 +435,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         diff = off_background(o, hc)
         outline = cov_outline(cov, cfg.image.outline_fill_px)  # handle shadows are holes in the plane, not its outline
         win = hc.background_win if hc.protrusion_from_surface else 0.0
-        bars = (protrusion_map(o, surf, hc, win, cfg.planes.offset_tol) if cfg.image.surface_rays
+        bars = (protrusion_map(o, surf, hc, win, cfg.planes.offset_tol) if rays
                 else protrusion_from_faces(o, centroids, mesh.face_normals, hc, win, cfg.planes.offset_tol))
         handles = find_handles(o, cov, cfg, diff, bars & outline, outline)
         thr = off_threshold(diff, o.n_views > 0, cfg)

@@ -16,7 +16,7 @@ from react3d_core.data.mesh import TriMesh
 from react3d_core.perception.heuristic.facets import planar_facets
 from react3d_core.perception.heuristic.front_cells import find_handles, split_cells
 from react3d_core.perception.heuristic.fronts import find_fronts
-from react3d_core.perception.heuristic.image_fronts import find_image_fronts
+from react3d_core.perception.heuristic.image_fronts import coarse_faces, find_image_fronts, modelled_surface
 from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, _nanmedian
 from react3d_core.perception.heuristic.plane_surface import PlaneSurface, cast_surface, flat_surface
 from react3d_core.perception.heuristic.planes import Plane, surface_samples, vertical_planes
@@ -189,6 +189,64 @@ def test_seamless_mesh_splits_into_two_doors_from_the_images(scale: float, shift
         assert res.calibration.scale == pytest.approx(scale, abs=0.03)
     else:
         assert res.calibration == ColourCalibration(before=res.calibration.before, after=res.calibration.after)
+
+
+def test_coarse_faces_by_area_weighted_median_size() -> None:
+    """n right triangles with 1 cm legs (5e-5 m2 each) and two with 3 cm legs (9e-4 m2 together): the
+    area-weighted median size is 3 cm while the small ones hold under half the area (n = 17: 8.5e-4 of
+    1.75e-3), 1 cm once they hold over half (n = 19: 9.5e-4 of 1.85e-3)."""
+    def tris(n_small: int) -> TriMesh:
+        legs = [0.01] * n_small + [0.03, 0.03]
+        v, f = [], []
+        for k, leg in enumerate(legs):
+            o = np.array([0.1 * k, 0.0, 0.0])
+            v += [o, o + [leg, 0, 0], o + [0, 0, leg]]
+            f.append([3 * k, 3 * k + 1, 3 * k + 2])
+        return TriMesh(np.array(v), np.array(f))
+    for n, coarse in ((17, True), (19, False)):
+        m = tris(n)
+        assert coarse_faces(m, np.arange(m.n_faces), 0.015) is coarse
+        assert coarse_faces(m, np.arange(m.n_faces), 0.0) is False  # 0: never
+    assert coarse_faces(tris(17), np.arange(17), 0.015) is False  # the small faces alone
+
+
+def test_modelled_surface_by_exact_normals() -> None:
+    """Two triangles facing -y exactly and one tilted 1 degree, 0.02 m2 each: 2/3 of the area is a group of
+    two faces with one exact normal (modelled at share 0.5, not at 0.7); a lone face is no group, whatever
+    its area; 1 mm of noise on every vertex (a scan) leaves no two normals equal."""
+    v = np.array([[0, 0, 0], [0.2, 0, 0], [0, 0, 0.2], [0.3, 0, 0], [0.5, 0, 0], [0.3, 0, 0.2],
+                  [0.6, 0, 0], [0.8, 0, 0], [0.6, 0.2 * np.tan(np.radians(1.0)), 0.2]], float)
+    m = TriMesh(v, np.array([[0, 1, 2], [3, 4, 5], [6, 7, 8]]))
+    assert modelled_surface(m, np.arange(3), 0.5) and not modelled_surface(m, np.arange(3), 0.7)
+    assert not modelled_surface(m, np.arange(3), 0.0)  # 0: never
+    assert not modelled_surface(m, np.array([0, 2]), 0.4)  # one face of each normal: no group
+    noisy = TriMesh(v + np.random.default_rng(0).normal(0, 0.001, v.shape), m.faces)
+    assert not modelled_surface(noisy, np.arange(3), 0.1)
+
+
+def test_a_decimated_scan_gives_the_fronts_of_the_fine_one() -> None:
+    """The photos are of the world; the scan is the same two doors in 2.5 cm faces (a decimated fused mesh).
+    Their centroids lie farther apart than the coverage closing (2 cm), so painted by centroids the plane
+    comes out mostly uncovered and no front is cut; its coverage read from rays gives both doors."""
+    _fine, frames, images = _seamless_cabinet_scene()
+    grey = lambda x, z: np.full((len(x), 3), 128, np.uint8)  # noqa: E731
+    rng = np.random.default_rng(0)
+    coarse = _merge(_grid_mesh(0.0, 1.2, 0.1, 0.8, 0.0, 0.025, grey), _grid_mesh(-0.5, 1.7, 0.0, 2.0, 0.6, 0.05, grey))
+    coarse = TriMesh(coarse.vertices + rng.normal(0, 0.001, coarse.vertices.shape) * [0, 1, 0], coarse.faces,
+                     coarse.colors)  # a scan's 1 mm depth noise: no exactly shared normals
+    assert not modelled_surface(coarse, np.arange(coarse.n_faces), 0.5)
+    read = lambda f: images[f.frame_id]  # noqa: E731
+    res = find_image_fronts(coarse, frames, Rasterizer(coarse), read, HeuristicConfig())
+    fronts = sorted(res.fronts, key=lambda f: f.center[0])
+    assert len(fronts) == 2, [(np.round(f.center, 2), f.w, f.h) for f in fronts]
+    for f, cu in zip(fronts, (0.3, 0.9)):
+        assert abs(abs(0.5 * (f.extent_u[0] + f.extent_u[1])) - cu) < 0.04 and abs(f.w - 0.6) < 0.06
+        assert f.kind == "door"
+    off = find_image_fronts(coarse, frames, Rasterizer(coarse), read, HeuristicConfig(image={"rays_face_edge": 0.0}))
+    assert len(off.fronts) < 2
+    flat = _merge(_grid_mesh(0.0, 1.2, 0.1, 0.8, 0.0, 0.025, grey), _grid_mesh(-0.5, 1.7, 0.0, 2.0, 0.6, 0.05, grey))
+    modelled = find_image_fronts(flat, frames, Rasterizer(flat), read, HeuristicConfig())  # exact: left to the mesh
+    assert len(modelled.fronts) < 2
 
 
 def _registration_errors(res, per_view: list[tuple[float, float, float]], W: int = 480, H: int = 360) -> np.ndarray:  # noqa: ANN001
