@@ -13,16 +13,10 @@ from react3d_core.perception.heuristic.front_cells import (Cell, Handle, _betwee
                                                            find_handles, split_cells)
 from react3d_core.perception.heuristic.fronts import Front
 from react3d_core.perception.heuristic.image_fronts import VetoEvidence, _cluttered, _hardware
-from react3d_core.perception.heuristic.orthophoto import Orthophoto
-from react3d_core.perception.heuristic.planes import Plane
+from tests.perception.heuristic.flat_orthos import flat_ortho
 
 
-def _ortho(img: np.ndarray, res: float = 0.004) -> Orthophoto:
-    """An orthophoto of plane y = 0 facing -y (u along x), every pixel seen by 5 views."""
-    h, w = img.shape[:2]
-    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
-                  (0.0, w * res), (0.0, h * res), w * h * res * res)
-    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+_ortho = flat_ortho
 
 
 def test_line_dark_over_part_of_the_cell_is_no_straight_seam() -> None:

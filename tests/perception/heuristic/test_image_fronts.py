@@ -19,9 +19,10 @@ from react3d_core.perception.heuristic.fronts import find_fronts
 from react3d_core.perception.heuristic.image_fronts import coarse_faces, find_image_fronts, modelled_surface
 from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, _nanmedian
 from react3d_core.perception.heuristic.plane_surface import PlaneSurface, cast_surface, flat_surface
-from react3d_core.perception.heuristic.planes import Plane, surface_samples, vertical_planes
+from react3d_core.perception.heuristic.planes import surface_samples, vertical_planes
 from react3d_core.raster import Rasterizer
 from react3d_core.synthetic.render import RayCaster
+from tests.perception.heuristic.flat_orthos import flat_ortho
 
 
 def _grid_mesh(x0: float, x1: float, z0: float, z1: float, y: float, step: float, colour) -> TriMesh:  # noqa: ANN001
@@ -76,10 +77,7 @@ def test_vertical_planes_split_l_shape_and_turned_cabinet() -> None:
 
 
 def _ortho(img: np.ndarray, res: float = 0.005) -> Orthophoto:
-    h, w = img.shape[:2]
-    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
-                  (0.0, w * res), (0.0, h * res), w * h * res * res)
-    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+    return flat_ortho(img, res)
 
 
 def _splat_surface(o: Orthophoto, cen: np.ndarray, nrm: np.ndarray) -> PlaneSurface:

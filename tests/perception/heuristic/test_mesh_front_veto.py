@@ -12,17 +12,13 @@ from react3d_core.perception.heuristic.front_cells import off_background, off_th
 from react3d_core.perception.heuristic.fronts import Front
 from react3d_core.perception.heuristic.image_fronts import VetoEvidence, _cluttered, _hardware
 from react3d_core.perception.heuristic.orthophoto import Orthophoto
-from react3d_core.perception.heuristic.planes import Plane
+from tests.perception.heuristic.flat_orthos import flat_ortho
 
 RES = 0.004
 
 
 def _ortho(img: np.ndarray) -> Orthophoto:
-    """An orthophoto of plane y = 0 facing -y (u along x, top at z = rows x RES), every pixel seen by 5 views."""
-    h, w = img.shape[:2]
-    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
-                  (0.0, w * RES), (0.0, h * RES), w * h * RES * RES)
-    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * RES, RES)
+    return flat_ortho(img, RES)
 
 
 def _front(o: Orthophoto, r0: int, r1: int, c0: int, c1: int) -> Front:

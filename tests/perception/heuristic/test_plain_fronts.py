@@ -10,8 +10,7 @@ from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
 from react3d_core.perception.heuristic.front_cells import split_cells
 from react3d_core.perception.heuristic.fronts import Front, _joint
 from react3d_core.perception.heuristic.image_fronts import piece_front, plain_fronts_kept, stacks
-from react3d_core.perception.heuristic.orthophoto import Orthophoto
-from react3d_core.perception.heuristic.planes import Plane
+from tests.perception.heuristic.flat_orthos import flat_ortho
 
 N = np.array([0.0, -1.0, 0.0])      # facing -y; u = z x n = (1, 0, 0)
 U = np.array([1.0, 0.0, 0.0])
@@ -109,12 +108,7 @@ def test_a_tall_front_with_a_horizontal_bar_is_a_side_hinged_door() -> None:
     assert kind == "drop" and abs(art.axis[0]) == 1.0
 
 
-def _ortho(img: np.ndarray, res: float = 0.004) -> Orthophoto:
-    """An orthophoto of plane y = 0 facing -y (u along x), every pixel seen by 5 views."""
-    h, w = img.shape[:2]
-    plane = Plane(np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0]), 0.0, np.zeros(0, np.int64),
-                  (0.0, w * res), (0.0, h * res), w * h * res * res)
-    return Orthophoto(plane, img.astype(np.float32), np.full((h, w), 5, np.int32), 0.0, h * res, res)
+_ortho = flat_ortho
 
 
 def test_bright_rows_cut_a_handle_less_chest_into_its_drawers() -> None:
