@@ -45,6 +45,15 @@ def horizontal_right(n: np.ndarray) -> np.ndarray:
     return u / np.linalg.norm(u)
 
 
+def weighted_median(values: np.ndarray, weights: np.ndarray) -> float:
+    """The value at which the weights sorted by value reach half their sum (the lower one on a tie): an
+    area-weighted median, which a few large faces or a handle cannot pull the way a mean is pulled."""
+    v, w = np.asarray(values, float), np.asarray(weights, float)
+    order = np.argsort(v, kind="stable")
+    half = np.searchsorted(np.cumsum(w[order]), 0.5 * w.sum())
+    return float(v[order][min(half, len(v) - 1)])
+
+
 def concat_meshes(pieces: Sequence[tuple[np.ndarray, np.ndarray]]) -> tuple[np.ndarray, np.ndarray]:
     """One (vertices, faces) from pieces ``(vertices_i, faces_i)``, each piece's faces offset past the
     vertices before it."""

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..config import ClipConfig
 from ..data.mesh import TriMesh
-from ..geometry import triangle_cross
+from ..geometry import triangle_cross, weighted_median
 
 
 def face_geometry(mesh: TriMesh, face_ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -72,10 +72,7 @@ def lid_plane(cen: np.ndarray, nrm: np.ndarray, area: np.ndarray, camera: np.nda
     a_up = float(area[up].sum())
     if a_up < config.lid_min_area_m2 or a_up < config.lid_ratio * vertical_area:
         return None
-    z, w = cen[up, 2], area[up]
-    order = np.argsort(z)
-    zc = float(z[order][np.searchsorted(np.cumsum(w[order]), 0.5 * a_up)])
-    return np.array([0.0, 0.0, -1.0]), zc
+    return np.array([0.0, 0.0, -1.0]), weighted_median(cen[up, 2], area[up])
 
 
 def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, config: ClipConfig) -> tuple[np.ndarray, np.ndarray | None, float | None]:

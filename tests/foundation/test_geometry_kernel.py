@@ -139,3 +139,13 @@ def test_concat_meshes_offsets_faces_and_horizontal_right():
     # facing a wall whose normal points back at the viewer along -y, the right is +x
     assert np.allclose(geometry.horizontal_right(np.array([0.0, -1.0, 0.0])), [1, 0, 0])
     assert np.allclose(geometry.horizontal_right(np.array([2.0, 0.0, 0.0])), [0, 1, 0])
+
+
+def test_weighted_median_by_hand():
+    from react3d_core.geometry import weighted_median
+
+    # sorted values 1, 2, 10 with weights 1, 1, 3: cumulative 1, 2, 5 reach half of 5 (2.5) at 10
+    assert weighted_median(np.array([10.0, 1.0, 2.0]), np.array([3.0, 1.0, 1.0])) == 10.0
+    # weights 2, 1, 1: cumulative 2 reaches half of 4 at the first value (the lower one on a tie)
+    assert weighted_median(np.array([10.0, 1.0, 2.0]), np.array([1.0, 2.0, 1.0])) == 1.0
+    assert weighted_median(np.array([0.5]), np.array([0.0])) == 0.5

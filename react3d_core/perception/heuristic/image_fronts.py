@@ -22,6 +22,7 @@ import numpy as np
 from ...config.heuristic import FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
+from ...geometry import weighted_median
 from ...raster import Rasterizer
 from .front_cells import Cell, Handle, find_handles, off_background, off_local, off_threshold, split_cells
 from .fronts import Front, _joint, _neighbours, doors_in_rows
@@ -116,10 +117,7 @@ def coarse_faces(mesh: TriMesh, faces: np.ndarray, edge: float) -> bool:
     if edge <= 0 or not len(faces):
         return False
     a = mesh.face_areas[faces]
-    size = np.sqrt(2.0 * a)
-    order = np.argsort(size)
-    half = np.searchsorted(np.cumsum(a[order]), 0.5 * a.sum())
-    return bool(size[order][min(half, len(order) - 1)] > edge)
+    return weighted_median(np.sqrt(2.0 * a), a) > edge
 
 
 def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) -> np.ndarray:
