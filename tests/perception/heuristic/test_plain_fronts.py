@@ -9,7 +9,7 @@ import numpy as np
 from react3d_core.config.heuristic import CellConfig, FrontRulesConfig, HeuristicConfig
 from react3d_core.perception.heuristic.front_cells import Cell, split_cells
 from react3d_core.perception.heuristic.fronts import Front, _joint
-from react3d_core.perception.heuristic.image_fronts import is_tiled, piece_front, plain_fronts_kept, stacks
+from react3d_core.perception.heuristic.image_fronts import fronts_share, is_tiled, piece_front, plain_fronts_kept, stacks
 from tests.perception.heuristic.flat_orthos import flat_ortho
 
 N = np.array([0.0, -1.0, 0.0])      # facing -y; u = z x n = (1, 0, 0)
@@ -112,6 +112,26 @@ def test_a_control_strip_does_not_make_an_appliance_front_a_tiling() -> None:
     holes[:, 15:] = False
     holes[30:, :] = False                                               # two tiles covered, ten holes
     assert not is_tiled(splash, holes, 0.01, cc)
+
+
+def test_a_piece_is_made_of_its_fronts() -> None:
+    """At 1 cm per px (u0 0, top at z 0.84 m): a washing machine 0.60 x 0.84 m whose porthole (a 0.40 m
+    square here, rows 30-70, columns 10-50) is no plane. Covered: 5040 - 1600 = 3440 px. Its control strip
+    cell u 0.20-0.60, z 0.62-0.84 covers 40 x 22 = 880 px: share 880 / 3440 = 0.256, below
+    ``piece_front_share`` 0.5. A dishwasher's door u 0-0.60, z 0-0.74 on a full 0.60 x 0.84 m plane covers
+    60 x 74 / (60 x 84) = 0.881. A front reaching past the grid is clipped to it."""
+    cov = np.ones((84, 60), bool)
+    cov[30:70, 10:50] = False
+    o = flat_ortho(np.ones((84, 60, 3)), 0.01)
+    strip = _front(0.20, 0.60, 0.62, 0.84)
+    assert abs(fronts_share([strip], o, cov) - 880 / 3440) < 1e-9
+    assert fronts_share([strip], o, cov) < CellConfig().piece_front_share
+    full = np.ones((84, 60), bool)
+    door = _front(0.0, 0.60, 0.0, 0.74)
+    assert abs(fronts_share([door], o, full) - 74 / 84) < 1e-9
+    assert abs(fronts_share([_front(-0.5, 0.60, -0.2, 2.0)], o, full) - 1.0) < 1e-9
+    assert fronts_share([], o, full) == 0.0
+    assert fronts_share([door], o, np.zeros((84, 60), bool)) == 0.0
 
 
 def test_a_tall_front_with_a_horizontal_bar_is_a_side_hinged_door() -> None:
