@@ -43,6 +43,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     (image.pane_rounds, image.pane_bar), and painted their frame's colour (image.pane_fill, image.pane_edge)
 # 24: a scan's plane whose faces are coarser than image.rays_face_edge (a decimated scan; not a modelled
 #     plane, image.modelled_share) reads its coverage and handles from rays, not its faces' centroids
-HEURISTIC_VERSION = "24"
+# 25: a plane is tiled only with cells.min_tiles tile-sized cells (an appliance's control strip is no
+#     tiling), and a piece's handle-less fronts cover cells.piece_front_share of its plane
+HEURISTIC_VERSION = "25"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

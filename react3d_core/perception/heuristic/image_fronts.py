@@ -19,7 +19,7 @@ import cv2
 import networkx as nx
 import numpy as np
 
-from ...config.heuristic import FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig
+from ...config.heuristic import CellConfig, FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...geometry import weighted_median
@@ -452,8 +452,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
         cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None)
-        tiled = any(max(c.c1 - c.c0, c.r1 - c.r0) * o.res < cfg.cells.min_tile_side
-                    and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cfg.cells.min_seen for c in cells)
+        tiled = is_tiled(cells, cov, o.res, cfg.cells)
         mine: list[Front] = []
         for cell in cells:
             f = _cell_front(o, cell, cov, clutter, in_plane, cfg, None,
@@ -467,7 +466,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                 if not tiled and 0 < cfg.cells.handleless_min_seams <= cell.seam_cuts:
                     gridded.add(id(f))
         if (not tiled and all(f.handle_points is None for f in mine)
-                and piece_front(cov, o.res, cfg.cells.piece_max_w, rules.max_h, cfg.cells.piece_fill)):
+                and piece_front(cov, o.res, cfg.cells.piece_max_w, rules.max_h, cfg.cells.piece_fill)
+                and fronts_share(mine, o, cov) >= cfg.cells.piece_front_share):
             pieces.update(id(f) for f in mine)
         fronts += mine
     if not cfg.cells.single_cut:
@@ -511,6 +511,36 @@ def plain_fronts_kept(fronts: list[Front], rules: FrontRulesConfig, gridded: set
         id(g) in base for g, _ in _neighbours(f, fronts, rules)))}
     keep = base | row_ends | pieces
     return [f for f in fronts if id(f) in keep]
+
+
+def fronts_share(fronts: Sequence[Front], o: Orthophoto, cov: np.ndarray) -> float:
+    """Share of a plane's coverage ``cov`` (grid of ``o``) that lies inside the rectangles of ``fronts`` on it.
+
+    Why: a piece standing free is made of its fronts (a fridge's doors, a dishwasher's door below its
+    control strip); a washing machine's porthole is no plane, so its only cell is the control strip over
+    it, 0.40 x 0.22 m of a 0.6 x 0.84 m front, which alone would pass as the piece's front."""
+    total = int(cov.sum())
+    if total == 0:
+        return 0.0
+    inside = np.zeros(cov.shape, bool)
+    for f in fronts:
+        c0, c1 = (int(round((u - o.u0) / o.res)) for u in f.extent_u)
+        r0, r1 = (int(round((o.v_top - v) / o.res)) for v in f.extent_v[::-1])
+        inside[max(r0, 0):max(r1, 0), max(c0, 0):max(c1, 0)] = True
+    return float((inside & cov).sum()) / total
+
+
+def is_tiled(cells: Sequence[Cell], cov: np.ndarray, res: float, cc: CellConfig) -> bool:
+    """Whether a plane's ``cells`` (on its coverage ``cov``, ``res`` m per px) are a tiling: at least
+    ``cc.min_tiles`` covered cells smaller than ``cc.min_tile_side`` both ways. A tiled wall's seams cut many
+    such cells, and then no handle-less cell there is a front by its seams or as a piece's front.
+
+    Why a count: an appliance's control strip (a dishwasher's, a washing machine's) is cut at its display
+    or buttons into one or two tile-sized cells above the door, and one such cell made the whole front a
+    tiling (the dishwasher drop doors of free-standing tuning 308 and 309 were lost)."""
+    n = sum(max(c.c1 - c.c0, c.r1 - c.r0) * res < cc.min_tile_side and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cc.min_seen
+            for c in cells)
+    return n >= max(cc.min_tiles, 1)
 
 
 def piece_front(cov: np.ndarray, res: float, max_w: float, max_h: float, fill: float) -> bool:

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
-from react3d_core.perception.heuristic.front_cells import split_cells
+from react3d_core.config.heuristic import CellConfig, FrontRulesConfig, HeuristicConfig
+from react3d_core.perception.heuristic.front_cells import Cell, split_cells
 from react3d_core.perception.heuristic.fronts import Front, _joint
-from react3d_core.perception.heuristic.image_fronts import piece_front, plain_fronts_kept, stacks
+from react3d_core.perception.heuristic.image_fronts import fronts_share, is_tiled, piece_front, plain_fronts_kept, stacks
 from tests.perception.heuristic.flat_orthos import flat_ortho
 
 N = np.array([0.0, -1.0, 0.0])      # facing -y; u = z x n = (1, 0, 0)
@@ -91,6 +91,47 @@ def test_piece_front_is_a_small_filled_rectangle() -> None:
     tall = np.ones((240, 80), bool)
     assert not piece_front(tall, 0.01, 2.0, 2.3, 0.6)
     assert not piece_front(np.zeros((10, 10), bool), 0.01, 2.0, 2.3, 0.6)
+
+
+def test_a_control_strip_does_not_make_an_appliance_front_a_tiling() -> None:
+    """At 1 cm per px, all covered: a dishwasher 0.45 m wide, its drop door 0.65 m tall below a 0.10 m control
+    strip cut at its display into 0.20 m and 0.25 m cells: one cell (0.20 x 0.10) is tile-sized (< 0.25 m
+    both ways), so the old any-cell test called the plane tiled and its handle-less door was no piece's
+    front; with ``min_tiles`` 3 it is not tiled. A splash-back cut into 3 x 4 tiles of 0.15 m is tiled; an
+    uncovered tile-sized cell (a hole) does not count."""
+    cov = np.ones((75, 45), bool)
+    dishwasher = [Cell(0, 0, 20, 10), Cell(20, 0, 45, 10), Cell(0, 10, 45, 75)]
+    cc = CellConfig()
+    assert cc.min_tiles == 3
+    assert not is_tiled(dishwasher, cov, 0.01, cc)
+    assert is_tiled(dishwasher, cov, 0.01, CellConfig(min_tiles=1))     # the rule before
+    tiles = np.ones((45, 60), bool)
+    splash = [Cell(c, r, c + 15, r + 15) for r in range(0, 45, 15) for c in range(0, 60, 15)]
+    assert is_tiled(splash, tiles, 0.01, cc)
+    holes = tiles.copy()
+    holes[:, 15:] = False
+    holes[30:, :] = False                                               # two tiles covered, ten holes
+    assert not is_tiled(splash, holes, 0.01, cc)
+
+
+def test_a_piece_is_made_of_its_fronts() -> None:
+    """At 1 cm per px (u0 0, top at z 0.84 m): a washing machine 0.60 x 0.84 m whose porthole (a 0.40 m
+    square here, rows 30-70, columns 10-50) is no plane. Covered: 5040 - 1600 = 3440 px. Its control strip
+    cell u 0.20-0.60, z 0.62-0.84 covers 40 x 22 = 880 px: share 880 / 3440 = 0.256, below
+    ``piece_front_share`` 0.5. A dishwasher's door u 0-0.60, z 0-0.74 on a full 0.60 x 0.84 m plane covers
+    60 x 74 / (60 x 84) = 0.881. A front reaching past the grid is clipped to it."""
+    cov = np.ones((84, 60), bool)
+    cov[30:70, 10:50] = False
+    o = flat_ortho(np.ones((84, 60, 3)), 0.01)
+    strip = _front(0.20, 0.60, 0.62, 0.84)
+    assert abs(fronts_share([strip], o, cov) - 880 / 3440) < 1e-9
+    assert fronts_share([strip], o, cov) < CellConfig().piece_front_share
+    full = np.ones((84, 60), bool)
+    door = _front(0.0, 0.60, 0.0, 0.74)
+    assert abs(fronts_share([door], o, full) - 74 / 84) < 1e-9
+    assert abs(fronts_share([_front(-0.5, 0.60, -0.2, 2.0)], o, full) - 1.0) < 1e-9
+    assert fronts_share([], o, full) == 0.0
+    assert fronts_share([door], o, np.zeros((84, 60), bool)) == 0.0
 
 
 def test_a_tall_front_with_a_horizontal_bar_is_a_side_hinged_door() -> None:
