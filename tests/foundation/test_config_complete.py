@@ -444,6 +444,7 @@ DEFAULTS = {
     "perception.heuristic.cells.min_seen": 0.55,
     "perception.heuristic.cells.min_tile_side": 0.25,
     "perception.heuristic.cells.min_tiles": 3,
+    "perception.heuristic.cells.tile_edge_strips": False,
     "perception.heuristic.cells.strip_seams": False,
     "perception.heuristic.cells.handleless_min_seams": 2,
     "perception.heuristic.cells.stack_min": 3,

@@ -34,6 +34,7 @@ from .planes import Plane, share_behind, vertical_planes
 
 _MIN_CUT_SIDES = 2  # a handle-less cell cut out on this many sides is cut out by the plane's seams
 _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
+_EDGE_NEAR = 0.01  # m: a cell this close to the coverage's top or bottom row runs along its edge
 
 
 @dataclass
@@ -538,9 +539,21 @@ def is_tiled(cells: Sequence[Cell], cov: np.ndarray, res: float, cc: CellConfig)
 
     Why a count: an appliance's control strip (a dishwasher's, a washing machine's) is cut at its display
     or buttons into one or two tile-sized cells above the door, and one such cell made the whole front a
-    tiling (the dishwasher drop doors of free-standing tuning 308 and 309 were lost)."""
-    n = sum(max(c.c1 - c.c0, c.r1 - c.r0) * res < cc.min_tile_side and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cc.min_seen
-            for c in cells)
+    tiling (the dishwasher drop doors of free-standing tuning 308 and 309 were lost).
+    A strip at most ``cc.edge_strip`` tall along the top or bottom of the coverage counts as no tile
+    (``cc.tile_edge_strips`` off): a plinth or cornice cut into pieces by the seams of the fronts above it
+    is no tiled wall (a TSDF wardrobe's plinth, cut in four by its door seams, left every handle-less
+    front of the wardrobe to the neighbour rules)."""
+    rows = np.flatnonzero(cov.any(1))
+    top, bottom = (int(rows[0]), int(rows[-1]) + 1) if len(rows) else (0, 0)
+    strip, near = cc.edge_strip / res, max(1, int(round(_EDGE_NEAR / res)))
+
+    def edge(c: Cell) -> bool:
+        return (not cc.tile_edge_strips and c.r1 - c.r0 <= strip
+                and (c.r0 - top <= near or bottom - c.r1 <= near))
+
+    n = sum(max(c.c1 - c.c0, c.r1 - c.r0) * res < cc.min_tile_side and not edge(c)
+            and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cc.min_seen for c in cells)
     return n >= max(cc.min_tiles, 1)
 
 

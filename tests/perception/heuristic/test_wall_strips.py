@@ -10,9 +10,8 @@ from react3d_core.config.heuristic import HeuristicConfig, RoomWallConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.geometry import concat_meshes
 from react3d_core.perception.heuristic.front_cells import Cell, split_cells
-from react3d_core.perception.heuristic.image_fronts import stands_in_room
-from react3d_core.perception.heuristic.planes import Plane
-from react3d_core.perception.heuristic.planes import share_behind
+from react3d_core.perception.heuristic.image_fronts import is_tiled, stands_in_room
+from react3d_core.perception.heuristic.planes import Plane, share_behind
 from tests.perception.heuristic.flat_orthos import flat_ortho
 
 
@@ -61,6 +60,32 @@ def test_a_piece_stands_in_the_room_an_outer_wall_does_not() -> None:
     assert stands_in_room(mesh, plane(2.4), rw)
     assert not stands_in_room(mesh, plane(3.0), rw)
     assert stands_in_room(mesh, plane(3.0), RoomWallConfig(behind_share=0.0))
+
+
+def test_a_plinth_cut_in_pieces_is_no_tiled_wall() -> None:
+    """A 1 x 1 m plane at 1 cm per px, fully covered: two doors (50 x 90 px) over a 0.1 m plinth strip the
+    door seams cut into four pieces, three of them tile-sized (0.2, 0.15 and 0.15 x 0.1 m; ``min_tiles`` 3).
+    The strip runs along the coverage's bottom edge and is at most ``cells.edge_strip`` (0.2 m) tall, so the
+    plane is no tiling; with ``tile_edge_strips`` it is (the rule before). Three 0.2 x 0.2 m cells in the
+    middle of the plane make a tiling either way, and so does a row of three as small 0.3 m above the edge.
+    The coverage's edge counts, not the grid's: a plane whose surface starts 30 px down has its top there."""
+    cov = np.ones((100, 100), bool)
+    plinth = [Cell(0, 90, 20, 100), Cell(20, 90, 35, 100), Cell(35, 90, 50, 100), Cell(50, 90, 100, 100)]
+    cells = [Cell(0, 0, 50, 90), Cell(50, 0, 100, 90)] + plinth
+    q = HeuristicConfig().cells
+    assert not is_tiled(cells, cov, 0.01, q)
+    assert is_tiled(cells, cov, 0.01, HeuristicConfig(cells={"tile_edge_strips": True}).cells)
+    tiles = [Cell(0, 0, 100, 40), Cell(0, 40, 20, 60), Cell(20, 40, 40, 60), Cell(40, 40, 60, 60),
+             Cell(60, 40, 100, 60), Cell(0, 60, 100, 100)]
+    assert is_tiled(tiles, cov, 0.01, q)
+    raised = [Cell(0, 0, 100, 60), Cell(0, 60, 20, 70), Cell(20, 60, 40, 70), Cell(40, 60, 60, 70),
+              Cell(60, 60, 100, 70), Cell(0, 70, 100, 100)]
+    assert is_tiled(raised, cov, 0.01, q)
+    low = np.zeros((100, 100), bool)
+    low[30:] = True
+    top = [Cell(0, 30, 20, 40), Cell(20, 30, 40, 40), Cell(40, 30, 60, 40), Cell(60, 30, 100, 40), Cell(0, 40, 100, 100)]
+    assert not is_tiled(top, low, 0.01, q)
+    assert is_tiled(top, low, 0.01, HeuristicConfig(cells={"tile_edge_strips": True}).cells)
 
 
 def test_seams_cutting_off_edge_strips_do_not_cut_a_wall_out() -> None:
