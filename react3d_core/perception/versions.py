@@ -45,6 +45,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     plane, image.modelled_share) reads its coverage and handles from rays, not its faces' centroids
 # 25: a plane is tiled only with cells.min_tiles tile-sized cells (an appliance's control strip is no
 #     tiling), and a piece's handle-less fronts cover cells.piece_front_share of its plane
-HEURISTIC_VERSION = "25"
+# 26: a seam cutting an edge strip off a cell is no seam of the larger side (cells.strip_seams), a piece's
+#     plane has scan surface behind it (cells.piece_behind): plain walls are no push-to-open fronts; and a
+#     plinth or cornice strip cut into pieces is no tiling (cells.tile_edge_strips)
+HEURISTIC_VERSION = "26"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -538,6 +538,13 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
     else:
         a = Cell(c.c0, c.r0, c.c1, c.r0 + ch_, cut_sides=n, seam_cuts=k)
         b = Cell(c.c0, c.r0 + ch_ + 1, c.c1, c.r1, cut_sides=n, seam_cuts=k)
+        if not q.strip_seams and strip_px > 0:
+            # a cut that takes a strip off the cell's top or bottom edge (a skirting board, a plinth, a
+            # cornice) is no seam of the larger side: a plain wall cut so is not cut out by seams
+            if a.r1 - a.r0 <= strip_px < b.r1 - b.r0:
+                b.seam_cuts = c.seam_cuts
+            elif b.r1 - b.r0 <= strip_px < a.r1 - a.r0:
+                a.seam_cuts = c.seam_cuts
     return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px)
             + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px))
 

@@ -19,7 +19,7 @@ import cv2
 import networkx as nx
 import numpy as np
 
-from ...config.heuristic import CellConfig, FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig
+from ...config.heuristic import CellConfig, FloorConfig, FrontRulesConfig, HandleConfig, HeuristicConfig, ImageConfig, RoomWallConfig
 from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...geometry import weighted_median
@@ -30,10 +30,11 @@ from .line_evidence import LineSupport, line_support
 from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
 from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
 from .plane_surface import PlaneSurface, cast_surface, flat_surface
-from .planes import Plane, vertical_planes
+from .planes import Plane, share_behind, vertical_planes
 
 _MIN_CUT_SIDES = 2  # a handle-less cell cut out on this many sides is cut out by the plane's seams
 _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
+_EDGE_NEAR = 0.01  # m: a cell this close to the coverage's top or bottom row runs along its edge
 
 
 @dataclass
@@ -467,7 +468,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                     gridded.add(id(f))
         if (not tiled and all(f.handle_points is None for f in mine)
                 and piece_front(cov, o.res, cfg.cells.piece_max_w, rules.max_h, cfg.cells.piece_fill)
-                and fronts_share(mine, o, cov) >= cfg.cells.piece_front_share):
+                and fronts_share(mine, o, cov) >= cfg.cells.piece_front_share
+                and (not cfg.cells.piece_behind or stands_in_room(mesh, o.plane, cfg.room_wall))):
             pieces.update(id(f) for f in mine)
         fronts += mine
     if not cfg.cells.single_cut:
@@ -537,10 +539,29 @@ def is_tiled(cells: Sequence[Cell], cov: np.ndarray, res: float, cc: CellConfig)
 
     Why a count: an appliance's control strip (a dishwasher's, a washing machine's) is cut at its display
     or buttons into one or two tile-sized cells above the door, and one such cell made the whole front a
-    tiling (the dishwasher drop doors of free-standing tuning 308 and 309 were lost)."""
-    n = sum(max(c.c1 - c.c0, c.r1 - c.r0) * res < cc.min_tile_side and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cc.min_seen
-            for c in cells)
+    tiling (the dishwasher drop doors of free-standing tuning 308 and 309 were lost).
+    A strip at most ``cc.edge_strip`` tall along the top or bottom of the coverage counts as no tile
+    (``cc.tile_edge_strips`` off): a plinth or cornice cut into pieces by the seams of the fronts above it
+    is no tiled wall (a TSDF wardrobe's plinth, cut in four by its door seams, left every handle-less
+    front of the wardrobe to the neighbour rules)."""
+    rows = np.flatnonzero(cov.any(1))
+    top, bottom = (int(rows[0]), int(rows[-1]) + 1) if len(rows) else (0, 0)
+    strip, near = cc.edge_strip / res, max(1, int(round(_EDGE_NEAR / res)))
+
+    def edge(c: Cell) -> bool:
+        return (not cc.tile_edge_strips and c.r1 - c.r0 <= strip
+                and (c.r0 - top <= near or bottom - c.r1 <= near))
+
+    n = sum(max(c.c1 - c.c0, c.r1 - c.r0) * res < cc.min_tile_side and not edge(c)
+            and cov[c.r0:c.r1, c.c0:c.c1].mean() >= cc.min_seen for c in cells)
     return n >= max(cc.min_tiles, 1)
+
+
+def stands_in_room(mesh: TriMesh, plane: Plane, rw: RoomWallConfig) -> bool:
+    """Whether scan surface lies behind ``plane`` as behind anything standing in the room (``rw.behind_share``
+    of the scan more than ``rw.depth`` behind it; ``planes.share_behind``): a piece's carcass and the room
+    around it do, an outer wall's stretch seen between furniture has nothing behind it."""
+    return share_behind(mesh, plane.n, plane.d, rw.depth, rw.wall_back, rw.plane_min_cos) >= rw.behind_share
 
 
 def piece_front(cov: np.ndarray, res: float, max_w: float, max_h: float, fill: float) -> bool:

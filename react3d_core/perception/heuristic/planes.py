@@ -392,3 +392,15 @@ def _pieces(sel: np.ndarray, samples: _Samples, area: np.ndarray, n: np.ndarray,
         out.append(Plane(n.copy(), u, d, sel[m], (float(pu[ms].min()), float(pu[ms].max())),
                          (float(pv[ms].min()), float(pv[ms].max())), a))
     return out
+
+
+def share_behind(mesh: TriMesh, n: np.ndarray, d: float, depth: float, wall_back: float, min_cos: float) -> float:
+    """Share of the scan's surface area lying more than ``depth`` behind the plane n·x = d (``n`` pointing
+    into the room), less the wall's own outer side: surface up to ``wall_back`` behind it facing away
+    (cosine to ``n`` below -``min_cos``), which no camera in the room saw. Why: a scan is taken from inside
+    a room, so an outer wall has nothing behind it, while a piece standing in the room has its carcass and
+    the room's other walls and floor behind its front."""
+    cen, area, nrm = mesh.face_centroids, mesh.face_areas, mesh.face_normals
+    off = cen @ n - d
+    own_back = (off > -wall_back) & (nrm @ n < -min_cos)
+    return float(area[(off < -depth) & ~own_back].sum()) / max(float(area.sum()), 1e-12)

@@ -23,6 +23,7 @@ from ...config.heuristic import FloorConfig, FrontRulesConfig, RoomWallConfig
 from ...data.mesh import TriMesh
 from .fronts import Front, _joint, _neighbours
 from .image_fronts import floor_level
+from .planes import share_behind
 
 
 def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> list[bool]:
@@ -33,7 +34,6 @@ def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> 
     if not fronts:
         return []
     cen, area, nrm = mesh.face_centroids, mesh.face_areas, mesh.face_normals
-    total = max(float(area.sum()), 1e-12)
     in_front = np.zeros(mesh.n_faces, bool)
     for f in fronts:
         in_front[f.faces] = True
@@ -41,8 +41,8 @@ def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> 
     for f in fronts:
         d = (cen - f.center) @ f.n_out
         # a modelled wall's own outer side is behind it, facing away: nothing a camera in the room saw
-        own_back = (d > -rules.wall_back) & (nrm @ f.n_out < -rules.plane_min_cos)
-        behind = float(area[(d < -rules.depth) & ~own_back].sum()) / total
+        behind = share_behind(mesh, f.n_out, float(f.center @ f.n_out), rules.depth, rules.wall_back,
+                              rules.plane_min_cos)
         wall = (d > -max(rules.plane_tol, rules.wall_band)) & (d < rules.plane_tol) & (nrm @ f.n_out > rules.plane_min_cos) & ~in_front
         out.append(behind < rules.behind_share and float(area[wall].sum()) >= rules.min_area)
     return out

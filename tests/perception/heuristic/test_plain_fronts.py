@@ -104,7 +104,7 @@ def test_a_control_strip_does_not_make_an_appliance_front_a_tiling() -> None:
     cc = CellConfig()
     assert cc.min_tiles == 3
     assert not is_tiled(dishwasher, cov, 0.01, cc)
-    assert is_tiled(dishwasher, cov, 0.01, CellConfig(min_tiles=1))     # the rule before
+    assert is_tiled(dishwasher, cov, 0.01, CellConfig(min_tiles=1, tile_edge_strips=True))  # the rules before
     tiles = np.ones((45, 60), bool)
     splash = [Cell(c, r, c + 15, r + 15) for r in range(0, 45, 15) for c in range(0, 60, 15)]
     assert is_tiled(splash, tiles, 0.01, cc)
