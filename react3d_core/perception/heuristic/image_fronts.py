@@ -195,6 +195,9 @@ def pane_frame_map(cov: np.ndarray, seen: np.ndarray | None, res: float, speck: 
     plane's depth) when given, with covered strokes and specks thinner than ``speck`` (m) taken off, then
     gaps up to ``gap`` (m) closed.
 
+    With ``reach`` (m), only what the views see that near the coverage is joined: farther in, what stands
+    right behind the glass (books on a laser scan's shelf) is seen at the plane's depth and closed panes.
+
     Why: a TSDF glass door's frame is thin and its fused surface ragged, so the coverage holds bits of it
     while the views see all of it; what stands behind the glass at the plane's depth (a shelf's front
     edge, a jar) is a thin line or a speck inside the pane, which split it or took its fill; and a rail
@@ -446,8 +449,9 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
             cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         seen_at_plane = o.n_views > 0
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
-        panes = framed_panes(pane_frame_map(cov, seen_at_plane if cfg.image.pane_seen else None, o.res,
-                                            cfg.image.pane_speck, cfg.image.pane_gap, cfg.image.pane_seen_reach), o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
+        framing = pane_frame_map(cov, seen_at_plane if cfg.image.pane_seen else None, o.res, cfg.image.pane_speck,
+                                 cfg.image.pane_gap, cfg.image.pane_seen_reach)
+        panes = framed_panes(framing, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
                              cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
                              cfg.image.pane_min_fill)
         if panes.any():
