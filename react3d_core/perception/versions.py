@@ -43,6 +43,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     (image.pane_rounds, image.pane_bar), and painted their frame's colour (image.pane_fill, image.pane_edge)
 # 24: a scan's plane whose faces are coarser than image.rays_face_edge (a decimated scan; not a modelled
 #     plane, image.modelled_share) reads its coverage and handles from rays, not its faces' centroids
-HEURISTIC_VERSION = "24"
+# 25: on a plane whose coverage holds under 90 % of what the views see near it, panes are sought on the
+#     coverage joined with that, specks and thin strokes taken off and gaps in a frame closed
+#     (image.pane_seen, pane_seen_reach, pane_seen_max_cover, pane_speck, pane_gap)
+HEURISTIC_VERSION = "25"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
