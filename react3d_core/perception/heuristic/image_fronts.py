@@ -212,10 +212,10 @@ def pane_frame_map(cov: np.ndarray, seen: np.ndarray | None, res: float, speck: 
             return cov.copy()
         out |= near.astype(np.uint8)
     k = int(round(speck / res)) | 1  # odd: an even kernel shifts what it keeps by a pixel
-    if k >= 3:
+    if k >= MIN_KERNEL:
         out = cv2.morphologyEx(out, cv2.MORPH_OPEN, np.ones((k, k), np.uint8))
     k = int(round(gap / res)) | 1
-    if k >= 3:
+    if k >= MIN_KERNEL:
         out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
     return out.astype(bool)
 
