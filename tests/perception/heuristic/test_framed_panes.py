@@ -166,11 +166,12 @@ def test_what_the_views_see_far_inside_a_pane_does_not_frame_it():
 
 def test_a_whole_scan_surface_frames_panes_alone():
     from react3d_core.perception.heuristic.image_fronts import pane_frame_map
-    # a laser scan: the coverage holds 95 % of what the views see near it; a 1.6 cm board the views see
-    # across an opening stays what it is (a frame map taken as it is), and no gap is closed
+    # a laser scan: the coverage holds 98 % of what the views see near it (a 2.4 cm shelf board behind
+    # the glass, seen at the plane's depth, lies partly within reach of the stiles): the map is the
+    # coverage as it is
     cov, sl = grid_with_hole(rim_px=15, hole=(100, 60))
     seen = cov.copy()
-    seen[100:104, 100:160] = True  # 240 px the scan lacks, against 4.6 k px of frame near it
+    seen[100:106, 100:160] = True
     assert np.array_equal(pane_frame_map(cov, seen, RES, 0.02, 0.08, reach=0.035, max_cover=0.9), cov)
-    ragged = pane_frame_map(cov, seen, RES, 0.0, 0.0, reach=0.035, max_cover=0.99)
-    assert ragged[100:104, 100:109].all() and not ragged[100:104, 112:148].any()  # under 99 %: joined near the frame
+    ragged = pane_frame_map(cov, seen, RES, 0.02, 0.08, reach=0.035, max_cover=1.0)  # no bound: joined
+    assert ragged[100:106, 100:109].all() and not ragged[100:106, 112:148].any()
