@@ -48,6 +48,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 26: a seam cutting an edge strip off a cell is no seam of the larger side (cells.strip_seams), a piece's
 #     plane has scan surface behind it (cells.piece_behind): plain walls are no push-to-open fronts; and a
 #     plinth or cornice strip cut into pieces is no tiling (cells.tile_edge_strips)
-HEURISTIC_VERSION = "26"
+# 27: on a plane whose coverage holds under 90 % of what the views see near it, panes are sought on the
+#     coverage joined with that, specks and thin strokes taken off and gaps in a frame closed
+#     (image.pane_seen, pane_seen_reach, pane_seen_max_cover, pane_speck, pane_gap)
+HEURISTIC_VERSION = "27"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -190,6 +190,37 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
     return keep[lab]
 
 
+def pane_frame_map(cov: np.ndarray, seen: np.ndarray | None, res: float, speck: float, gap: float,
+                   reach: float | None = None, max_cover: float = 1.0) -> np.ndarray:
+    """What may frame a pane: the plane's coverage, joined with ``seen`` (what the views see at the
+    plane's depth) when given, with covered strokes and specks thinner than ``speck`` (m) taken off, then
+    gaps up to ``gap`` (m) closed.
+
+    With ``reach`` (m), only what the views see that near the coverage is joined: farther in, what stands
+    right behind the glass (books on a laser scan's shelf) is seen at the plane's depth and closed panes.
+    Where the coverage holds at least ``max_cover`` of what the views see (near it), the scan's surface is
+    whole and the coverage alone frames panes, as it is: a laser scan holds its doors' frames, and
+    there the extra panes the views' frame gave cut cells wrong.
+
+    Why: a TSDF glass door's frame is thin and its fused surface ragged, so the coverage holds bits of it
+    while the views see all of it; what stands behind the glass at the plane's depth (a shelf's front
+    edge, a jar) is a thin line or a speck inside the pane, which split it or took its fill; and a rail
+    the fusion broke in places let the pane run out into the open through a gap of a few centimetres."""
+    out = cov.astype(np.uint8)
+    if seen is not None:
+        near = seen if reach is None else seen & seen_near(cov, res, reach)
+        if near.any() and (cov & near).sum() >= max_cover * near.sum():
+            return cov.copy()
+        out |= near.astype(np.uint8)
+    k = int(round(speck / res)) | 1  # odd: an even kernel shifts what it keeps by a pixel
+    if k >= MIN_KERNEL:
+        out = cv2.morphologyEx(out, cv2.MORPH_OPEN, np.ones((k, k), np.uint8))
+    k = int(round(gap / res)) | 1
+    if k >= MIN_KERNEL:
+        out = cv2.morphologyEx(out, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
+    return out.astype(bool)
+
+
 def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float, rounds: int = 1,
                  min_side: float = 0.0, bar: float = 0.0, min_fill: float = 0.0) -> np.ndarray:
     """``_framed_holes`` taken ``rounds`` times, each round on the coverage with the panes found so far
@@ -423,8 +454,11 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
             cov = coverage_map(o, flat, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         else:
             cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
+        seen_at_plane = o.n_views > 0
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
-        panes = framed_panes(cov, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
+        framing = pane_frame_map(cov, seen_at_plane if cfg.image.pane_seen else None, o.res, cfg.image.pane_speck,
+                                 cfg.image.pane_gap, cfg.image.pane_seen_reach, cfg.image.pane_seen_max_cover)
+        panes = framed_panes(framing, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
                              cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
                              cfg.image.pane_min_fill)
         if panes.any():

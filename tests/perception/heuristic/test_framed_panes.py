@@ -105,3 +105,73 @@ def test_a_ragged_framed_hole_is_no_pane():
     assert not framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8).any()
     cov, sl = grid_with_hole(rim_px=15)
     assert framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8)[sl].all()  # a rectangle stays one
+
+
+def test_a_frame_the_views_see_but_the_scan_holds_in_bits_frames_a_pane():
+    from react3d_core.perception.heuristic.image_fronts import pane_frame_map
+    # a TSDF glass door: the views see its whole 6 cm frame; the scan's flat surface holds the top rail
+    # in 2 cm stretches 2 cm apart and the left stile's outer 4 cm only (the fused surface is ragged there)
+    seen, sl = grid_with_hole(rim_px=15)
+    cov = seen.copy()
+    for c in range(85, 175, 10):
+        cov[45:60, c:c + 5] = False
+    cov[45:175, 95:100] = False
+    assert not framed_panes(cov, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8).any()
+    frame = pane_frame_map(cov, seen, RES, speck=0.0, gap=0.0, reach=0.035)
+    assert np.array_equal(frame, seen)
+    assert framed_panes(frame, RES, 0.035, 0.9, 0.01, min_side=0.1, min_fill=0.8)[sl].all()
+    assert np.array_equal(pane_frame_map(cov, None, RES, 0.0, 0.0), cov)  # without the views: the scan alone
+
+
+def test_specks_behind_the_glass_are_taken_off_and_a_broken_rail_is_closed():
+    from react3d_core.perception.heuristic.image_fronts import pane_frame_map
+    seen, sl = grid_with_hole(rim_px=15, hole=(100, 60))  # a 40 x 24 cm pane, 6 cm frame
+    seen[100:104, 100:160] = True  # a shelf's front edge 1.6 cm tall seen across it at the plane's depth
+    seen[120:124, 110:114] = True  # ... and a jar's rim, a 1.6 cm speck
+    seen[45:60, 120:135] = False  # the top rail broken over 6 cm: the pane runs out into the open
+    kw = dict(frame=0.035, cover=0.9, min_area=0.01, rounds=3, min_side=0.1, bar=0.02, min_fill=0.8)
+    assert not framed_panes(pane_frame_map(seen, None, RES, speck=0.0, gap=0.0), RES, **kw).any()
+    assert not framed_panes(pane_frame_map(seen, None, RES, speck=0.02, gap=0.0), RES, **kw).any()  # still open
+    assert not framed_panes(pane_frame_map(seen, None, RES, speck=0.0, gap=0.08), RES, **kw)[sl].all()  # split
+    panes = framed_panes(pane_frame_map(seen, None, RES, speck=0.02, gap=0.08), RES, **kw)
+    want = np.zeros_like(seen)
+    want[sl] = True
+    assert np.array_equal(panes, want)  # one pane, the shelf's edge and the jar in it; the frame is none
+
+
+def test_the_frame_map_keeps_an_open_shelfs_narrow_rim_and_a_gap_between_fronts_unframed():
+    from react3d_core.perception.heuristic.image_fronts import pane_frame_map
+    kw = dict(frame=0.035, cover=0.9, min_area=0.01, rounds=3, min_side=0.1, bar=0.02, min_fill=0.8)
+    rim, _ = grid_with_hole(rim_px=5)  # a 2 cm carcass edge round an open shelf, seen by the views
+    assert not framed_panes(pane_frame_map(rim, rim, RES, speck=0.02, gap=0.08), RES, **kw).any()
+    fronts = np.ones((200, 300), bool)
+    fronts[:, 148:151] = False  # a gap between two fronts, top to bottom
+    fronts[60:160, 20:80] = False  # ... and a 24 x 40 cm opening cut into the plane's edge
+    fronts[60:160, 0:20] = False
+    assert not framed_panes(pane_frame_map(fronts, fronts, RES, speck=0.02, gap=0.08), RES, **kw).any()
+
+
+def test_what_the_views_see_far_inside_a_pane_does_not_frame_it():
+    from react3d_core.perception.heuristic.image_fronts import pane_frame_map
+    # a laser scan's glass door: the scan holds the 6 cm frame; the views see books standing right
+    # behind the glass, at the plane's depth, over the lower half of the pane, 4-8 cm in from the frame
+    cov, sl = grid_with_hole(rim_px=15, hole=(100, 60))
+    seen = cov.copy()
+    seen[110:150, 110:150] = True
+    kw = dict(frame=0.035, cover=0.9, min_area=0.01, rounds=3, min_side=0.1, bar=0.02, min_fill=0.8)
+    assert not framed_panes(pane_frame_map(cov, seen, RES, speck=0.02, gap=0.08), RES, **kw)[sl].all()
+    panes = framed_panes(pane_frame_map(cov, seen, RES, speck=0.02, gap=0.08, reach=0.035), RES, **kw)
+    assert panes[sl].all()
+
+
+def test_a_whole_scan_surface_frames_panes_alone():
+    from react3d_core.perception.heuristic.image_fronts import pane_frame_map
+    # a laser scan: the coverage holds 98 % of what the views see near it (a 2.4 cm shelf board behind
+    # the glass, seen at the plane's depth, lies partly within reach of the stiles): the map is the
+    # coverage as it is
+    cov, sl = grid_with_hole(rim_px=15, hole=(100, 60))
+    seen = cov.copy()
+    seen[100:106, 100:160] = True
+    assert np.array_equal(pane_frame_map(cov, seen, RES, 0.02, 0.08, reach=0.035, max_cover=0.9), cov)
+    ragged = pane_frame_map(cov, seen, RES, 0.02, 0.08, reach=0.035, max_cover=1.0)  # no bound: joined
+    assert ragged[100:106, 100:109].all() and not ragged[100:106, 112:148].any()
