@@ -27,6 +27,8 @@ from .keys import canonical, content_key
 from .scene import loaded_scene
 from .store import cache_root, get, relative, resolve, seal_dir
 
+COMPLETED_SCAN = "scan_completed.ply"  # a result's own copy of a scan this program completed
+
 __all__ = ["OUTPUT_KIND", "assemble", "export", "fill_output", "output_marker", "publish", "publish_body", "stage_output"]
 
 
@@ -89,8 +91,14 @@ def fill_output(result: dict[str, Any], staging: str | Path, out_dir: str | Path
     mesh = Path(scan_mesh_path) if scan_mesh_path else Path(manifest.input_mesh)
     mesh = mesh.resolve() if mesh.is_absolute() or scan_mesh_path else (src / mesh).resolve()
     _copy_folder(src, staging)
-    # the scan mesh stays where it is: re-point the manifest's reference from the new folder
-    rel = os.path.relpath(mesh, out.resolve())
+    if mesh.is_relative_to(cache_root().resolve()):
+        # a scan this program completed (slabs over surfaces the sensor missed) lives in the cache, which
+        # is pruned (and a benchmark's cold cache removed): the result keeps its own copy
+        shutil.copy2(mesh, staging / COMPLETED_SCAN)
+        rel = COMPLETED_SCAN
+    else:
+        # the scan mesh stays where it is: re-point the manifest's reference from the new folder
+        rel = os.path.relpath(mesh, out.resolve())
     manifest.model_copy(update={"input_mesh": rel}).save(staging / "scene.json")
     return str(staging / "scene.json")
 

@@ -131,3 +131,32 @@ def test_cold_cache_recomputes_and_leaves_a_self_contained_result(scene: Path, t
     assert not root.exists() and not any((tmp_path / "cold").iterdir()) and cache_root() == warm_store
     m = InteractiveScene.load(manifest)  # the published result does not point into the deleted cache
     assert m.objects and all((Path(manifest).parent / o.part_mesh).is_file() for o in m.objects)
+
+
+def test_a_completed_scan_in_the_cache_is_copied_into_the_result(tmp_path: Path, monkeypatch) -> None:  # noqa: ANN001
+    """A scan this program completed (slabs over surfaces the sensor missed) lives in the cache; the
+    published result keeps its own copy, so pruning the cache (or a benchmark's cold cache going) leaves
+    it whole. A scan outside the cache stays where it is, referred to relatively."""
+    from react3d_core.data.parts import InteractiveScene
+    from tasks.assembly import COMPLETED_SCAN, fill_output
+    from tasks.store import cache_root
+
+    monkeypatch.setenv("REACT3D_CACHE", str(tmp_path / "cache"))
+    src = cache_root() / "scenes" / "ab" / "assemble-x"
+    src.mkdir(parents=True)
+    InteractiveScene(scene_id="s", input_mesh="unused.ply", background_mesh="bg.ply").save(src / "scene.json")
+    (src / "bg.ply").write_bytes(b"background")
+    completed = cache_root() / "missed_surface" / "ab" / "abc.ply"
+    completed.parent.mkdir(parents=True)
+    completed.write_bytes(b"completed scan")
+    result = {"path": str((src / "scene.json").relative_to(cache_root()))}
+    out = tmp_path / "out"
+    manifest = Path(fill_output(result, tmp_path / ".out-staging", out, str(completed)))
+    m = InteractiveScene.load(manifest)
+    assert m.input_mesh == COMPLETED_SCAN and (manifest.parent / COMPLETED_SCAN).read_bytes() == b"completed scan"
+    scan = tmp_path / "scan" / "mesh.ply"
+    scan.parent.mkdir()
+    scan.write_bytes(b"the user's scan")
+    manifest = Path(fill_output(result, tmp_path / ".out-staging2", out, str(scan)))
+    assert InteractiveScene.load(manifest).input_mesh == "../scan/mesh.ply"
+    assert not (manifest.parent / COMPLETED_SCAN).exists()
