@@ -40,9 +40,8 @@ def on_outer_wall(fronts: list[Front], mesh: TriMesh, rules: RoomWallConfig) -> 
     out = []
     for f in fronts:
         d = (cen - f.center) @ f.n_out
-        # a modelled wall's own outer side is behind it, facing away: nothing a camera in the room saw
-        behind = share_behind(mesh, f.n_out, float(f.center @ f.n_out), rules.depth, rules.wall_back,
-                              rules.plane_min_cos)
+        behind = share_behind(  # a modelled wall's own outer side is left out (planes.share_behind)
+            mesh, f.n_out, float(f.center @ f.n_out), rules.depth, rules.wall_back, rules.plane_min_cos)
         wall = (d > -max(rules.plane_tol, rules.wall_band)) & (d < rules.plane_tol) & (nrm @ f.n_out > rules.plane_min_cos) & ~in_front
         out.append(behind < rules.behind_share and float(area[wall].sum()) >= rules.min_area)
     return out
