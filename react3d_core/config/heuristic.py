@@ -335,6 +335,8 @@ class HandleConfig(StageConfig):
     knob_aspect: float = Field(1.6, ge=1, description="A knob's long side is at most this times its short side.")
     knob_min_fill: float = Field(0.7, ge=0, le=1, description="A knob's blob fills at least this share of its box (a round knob fills ~0.79; speckle on a dark front fills 0.2-0.6).")
     seam_share: float = Field(0.9, ge=0, le=1, description="A blob with at least this share of its pixels on straight seam evidence longer than any handle is a piece of a seam, not a handle (a fused seam is 3-5 px wide; where only part of it passes the contrast it is a bar-sized blob). At 0.5 a RedKitchen bar beside a door seam went too (every 4th frame: 6 / 4 -> 5 / 5). 0: off.")
+    bar_plane_min: int = Field(2, ge=0, description="On a plane where at least this many handles stand out of the scan (bar_share of their pixels on the surface in front of the plane), colour-only handles are panel bevels and shading lines, not handles (0: off).")
+    bar_share: float = Field(0.5, ge=0, le=1, description="... share of a handle's pixels on that surface that makes it a handle in the scan.")
 
 
 class CellConfig(StageConfig):

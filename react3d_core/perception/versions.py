@@ -51,6 +51,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 27: on a plane whose coverage holds under 90 % of what the views see near it, panes are sought on the
 #     coverage joined with that, specks and thin strokes taken off and gaps in a frame closed
 #     (image.pane_seen, pane_seen_reach, pane_seen_max_cover, pane_speck, pane_gap)
-HEURISTIC_VERSION = "27"
+# 28: on a plane where at least two handles stand out of the scan, colour-only handle blobs are panel
+#     bevels and shading lines, not handles (handles.bar_plane_min, bar_share)
+HEURISTIC_VERSION = "28"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

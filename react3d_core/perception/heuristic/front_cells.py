@@ -207,7 +207,26 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
             continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
+    if protrusion is not None and not bars_only:
+        out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share)
     return out
+
+
+def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, share: float) -> list[Handle]:
+    """``handles`` less the colour-only ones when at least ``min_bars`` of them (0: never) stand out of the
+    scan: ``share`` or more of their pixels on ``bars`` (the surface in front of the plane).
+
+    Why: a plane whose handles the scan holds as bars shows its handles there; a raised panel's bevels
+    and the shading along its frame are straight colour lines of a bar's size beside them (a
+    scene-synthesizer door's panel edge under its bar, the worktop's shadow along a drawer's top), and
+    every one read as a handle cut its door between it and the door's real handle. A handle the views see
+    but the scan does not hold is kept on planes where no handles stand out (a decimated or a real scan)."""
+    if min_bars <= 0:
+        return handles
+    on_bar = [float(bars[h.pixels[:, 1], h.pixels[:, 0]].mean()) >= share for h in handles]
+    if sum(on_bar) < min_bars:
+        return handles
+    return [h for h, b in zip(handles, on_bar) if b]
 
 
 def _is_knob(w: int, h: int, area: int, res: float, p: HandleConfig) -> bool:

@@ -1,0 +1,72 @@
+"""Handles the scan holds as bars outrank colour-only blobs on their plane (front_cells.bars_outrank_colour)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from react3d_core.config.heuristic import HeuristicConfig
+from react3d_core.perception.heuristic.front_cells import Handle, bars_outrank_colour, find_handles, split_cells
+from tests.perception.heuristic.flat_orthos import flat_ortho
+
+
+def _handle(c0: int, r0: int, c1: int, r1: int) -> Handle:
+    rr, cc = np.mgrid[r0:r1, c0:c1]
+    return Handle((c0, r0, c1, r1), c1 - c0 >= r1 - r0, np.stack([cc.ravel(), rr.ravel()], 1))
+
+
+def test_bars_outrank_colour_by_hand() -> None:
+    """Three handles on a 20 x 20 px grid: A (4 px, all on bars), B (4 px, 2 on bars: share 0.5), C (4 px, none).
+    With min_bars 2 and share 0.5, A and B stand out of the scan and C goes; with min_bars 3 only two stand
+    out, so all three stay; min_bars 0 is off; share 0.6 leaves B colour-only, one bar, all stay."""
+    bars = np.zeros((20, 20), bool)
+    a, b, c = _handle(0, 0, 4, 1), _handle(0, 5, 4, 6), _handle(0, 10, 4, 11)
+    bars[0, 0:4] = True
+    bars[5, 0:2] = True
+    assert bars_outrank_colour([a, b, c], bars, 2, 0.5) == [a, b]
+    assert bars_outrank_colour([a, b, c], bars, 3, 0.5) == [a, b, c]
+    assert bars_outrank_colour([a, b, c], bars, 0, 0.5) == [a, b, c]
+    assert bars_outrank_colour([a, b, c], bars, 2, 0.6) == [a, b, c]
+
+
+def _two_raised_panel_doors() -> tuple[np.ndarray, np.ndarray]:
+    """A 0.8 x 0.7 m plane (200 x 175 px at 4 mm) of two doors side by side, each with a pale vertical bar
+    handle 16 x 1.6 cm that stands out of the scan (cols 85-88 and 111-114, rows 40-79), and a dark bevel line
+    26 x 2 cm along its panel's bottom (rows 150-154; cols 15-79 and 120-184) that only the colour shows."""
+    rng = np.random.default_rng(3)
+    img = np.full((175, 200, 3), 0.5, np.float32) + rng.normal(0, 0.003, (175, 200, 3)).astype(np.float32)
+    bars = np.zeros((175, 200), bool)
+    for c0 in (85, 111):
+        img[40:80, c0:c0 + 4] = 0.9
+        bars[40:80, c0:c0 + 4] = True
+    img[150:155, 15:80] = 0.2
+    img[150:155, 120:185] = 0.2
+    return img, bars
+
+
+def test_bevel_lines_do_not_cut_doors_beside_bar_handles() -> None:
+    """The two doors of ``_two_raised_panel_doors``. Read by colour alone, each bevel line is a 26 x 2 cm bar
+    (a handle's size) and the plane holds four handles, so the split leaves each door's bevel in a cell of
+    its own (more than two cells). With the bars outranking colour, the two bars are the handles and the
+    plane is cut once, between them: two cells, one handle each."""
+    img, bars = _two_raised_panel_doors()
+    o = flat_ortho(img)
+    cov = np.ones(bars.shape, bool)
+    off = HeuristicConfig(handles={"bar_plane_min": 0})
+    on = HeuristicConfig()
+    colour = find_handles(o, cov, off, protrusion=bars)
+    assert len(colour) == 4
+    assert len(split_cells(o, cov, colour, off)) > 2
+    kept = find_handles(o, cov, on, protrusion=bars)
+    assert len(kept) == 2 and not any(h.horizontal for h in kept)
+    cells = split_cells(o, cov, kept, on)
+    assert len(cells) == 2 and [len(c.handles) for c in cells] == [1, 1]
+    assert 89 <= min(c.c1 for c in cells) <= 111
+
+
+def test_colour_handles_stay_where_no_bar_stands_out() -> None:
+    """The same plane with one bar left in the scan (a decimated or a real scan that lost the other): under
+    bar_plane_min (2) bars, the colour is all the plane shows of its handles, and all four stay."""
+    img, bars = _two_raised_panel_doors()
+    bars[:, 100:] = False
+    o = flat_ortho(img)
+    assert len(find_handles(o, np.ones(bars.shape, bool), HeuristicConfig(), protrusion=bars)) == 4
