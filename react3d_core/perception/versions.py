@@ -51,6 +51,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 27: on a plane whose coverage holds under 90 % of what the views see near it, panes are sought on the
 #     coverage joined with that, specks and thin strokes taken off and gaps in a frame closed
 #     (image.pane_seen, pane_seen_reach, pane_seen_max_cover, pane_speck, pane_gap)
-HEURISTIC_VERSION = "27"
+# 29: a ring standing proud of a plane all round a door-sized circle is a porthole door hinged at a side; the
+#     plane's cells covering it and its plate's handle-less strips over and under it are no fronts (portholes)
+HEURISTIC_VERSION = "29"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
