@@ -472,7 +472,7 @@ class PortholeConfig(StageConfig):
     inner: float = Field(0.45, ge=0, le=1, description="... and the disc within this share of the radius ...")
     inner_max: float = Field(0.1, ge=0, le=1, description="... is at most this share proud (the glass bowl is no surface; a round boss or a clock is a filled disc).")
     face_depth: tuple[float, float] = Field((-0.02, 0.12), description="Faces this far behind/in front of the plane are the door's (m): its ring and bowl stand up to 10 cm proud of the plate.")
-    plate_gap: float = Field(0.15, ge=0, description="A handle-less front as wide as the door within this (m) above or below it is a strip of the appliance's plate (cut by the door's and the control panel's edges), no front.")
+    plate_gap: float = Field(0.15, ge=0, description="A front as wide as the door within this (m) above or below it is a strip of the appliance's plate (cut by the door's and the control panel's edges; the panel's knob may read as a handle), no front.")
 
 
 class HeuristicConfig(StageConfig):

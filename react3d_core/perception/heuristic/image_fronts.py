@@ -37,7 +37,7 @@ _MIN_CUT_SIDES = 2  # a handle-less cell cut out on this many sides is cut out b
 _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
 _EDGE_NEAR = 0.01  # m: a cell this close to the coverage's top or bottom row runs along its edge
 _PORTHOLE_COVERED = 0.5  # a cell's front covering this share of a porthole door is the plate around it
-_PORTHOLE_SPAN = 0.9  # a handle-less strip spanning this share of a porthole door's width is the plate
+_PORTHOLE_SPAN = 0.9  # a strip spanning this share of a porthole door's width is the plate
 
 
 @dataclass
@@ -823,11 +823,10 @@ def _overlap(f: Front, g: Front) -> float:
 
 
 def _plate_strip(f: Front, door: Front, gap: float) -> bool:
-    """``f`` is a handle-less strip of the plate around porthole ``door``: at least as wide as the door
-    (``_PORTHOLE_SPAN`` of it), within ``gap`` above or below it. A drawer beside the porthole (detergent)
-    is narrower; the plate's strips between seams and the control panel are not fronts."""
-    if f.handle_points is not None:
-        return False
+    """``f`` is a strip of the plate around porthole ``door``: at least as wide as the door (``_PORTHOLE_SPAN``
+    of it), within ``gap`` above or below it. A drawer beside the porthole (detergent) is narrower; the
+    plate's strips between seams and the control panel are not fronts, whatever its knob and the drawer's
+    edge read as (a handle: free-standing tuning 311)."""
     fu = float(f.center @ door.u)
     span = min(fu + f.w / 2, door.extent_u[1]) - max(fu - f.w / 2, door.extent_u[0])
     apart = max(f.extent_v[0] - door.extent_v[1], door.extent_v[0] - f.extent_v[1])

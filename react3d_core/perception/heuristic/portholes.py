@@ -13,8 +13,10 @@ import cv2
 import numpy as np
 
 from ...config.heuristic import PortholeConfig
+from .constants import CONNECTIVITY
 
 _SECTORS = 24  # angular sectors the ring's pixels must reach round its centre
+_QUARTER = 0.25  # the radius is a quarter of the box's width plus height (their mean half)
 
 
 def find_portholes(proud: np.ndarray, res: float, cfg: PortholeConfig) -> list[tuple[int, int, int, int]]:
@@ -25,7 +27,7 @@ def find_portholes(proud: np.ndarray, res: float, cfg: PortholeConfig) -> list[t
     radius) at most ``cfg.inner_max`` proud (a round boss, a clock or a lamp is a filled disc)."""
     if not proud.any():
         return []
-    n, lab, stats, _ = cv2.connectedComponentsWithStats(proud.astype(np.uint8), connectivity=8)
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(proud.astype(np.uint8), connectivity=CONNECTIVITY)
     out: list[tuple[int, int, int, int]] = []
     lo, hi = cfg.diameter[0] / res, cfg.diameter[1] / res
     for k in range(1, n):
@@ -34,7 +36,7 @@ def find_portholes(proud: np.ndarray, res: float, cfg: PortholeConfig) -> list[t
             continue
         rows, cols = np.nonzero(lab[r0:r0 + h, c0:c0 + w] == k)
         cy, cx = 0.5 * (h - 1), 0.5 * (w - 1)
-        rad = 0.25 * (w + h)
+        rad = _QUARTER * (w + h)
         dist = np.hypot(rows - cy, cols - cx) / rad
         if np.mean((dist >= cfg.band[0]) & (dist <= cfg.band[1])) < cfg.ring_share:
             continue
