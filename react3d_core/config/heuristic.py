@@ -462,6 +462,21 @@ RENAMED: dict[str, str] = {
 }
 
 
+class PortholeConfig(StageConfig):
+    """Round doors (washing machines, dryers): a ring standing proud of a plane (perception/heuristic/portholes.py)."""
+
+    enabled: bool = Field(True, description="A ring of surface standing handles.protrusion_depth proud of a plane, all round a circle of a door's size with nothing proud inside, is a round door hinged at a side; the cells its plane's fronts would cover are replaced by it (off: the plate around it is cut into cells as any plane).")
+    diameter: tuple[float, float] = Field((0.3, 0.6), description="The ring's outer diameter (min, max; m): washing machine and dryer doors are 0.4-0.5 m.")
+    max_aspect: float = Field(1.25, ge=1, description="Its box is at most this much wider than tall or the other way (a round ring, seen straight).")
+    band: tuple[float, float] = Field((0.55, 1.15), description="Its pixels lie within this band of the radius from the box's centre ...")
+    ring_share: float = Field(0.85, ge=0, le=1, description="... this share of them at least (a square frame has 43 % of its outline beyond 1.15 of its half side) ...")
+    sectors: float = Field(0.75, ge=0, le=1, description="... reaching this share of the sectors round the centre (a fused ring breaks in places) ...")
+    inner: float = Field(0.45, ge=0, le=1, description="... and the disc within this share of the radius ...")
+    inner_max: float = Field(0.1, ge=0, le=1, description="... is at most this share proud (the glass bowl is no surface; a round boss or a clock is a filled disc).")
+    face_depth: tuple[float, float] = Field((-0.02, 0.12), description="Faces this far behind/in front of the plane are the door's (m): its ring and bowl stand up to 10 cm proud of the plate.")
+    plate_gap: float = Field(0.15, ge=0, description="A front as wide as the door within this (m) above or below it is a strip of the appliance's plate (cut by the door's and the control panel's edges; the panel's knob may read as a handle), no front.")
+
+
 class HeuristicConfig(StageConfig):
     """The weight-free heuristic: planar facets and fronts on the scan mesh, per-frame renders, and the
     image path (fronts found in the colour frames: seams, handles) and sliding-door pairs."""
@@ -485,6 +500,7 @@ class HeuristicConfig(StageConfig):
     lines: LineConfig = Field(default_factory=LineConfig, description="Image path: seams supported by learned line segments (opt-in).")
     handles: HandleConfig = Field(default_factory=HandleConfig, description="Image path: handles.")
     cells: CellConfig = Field(default_factory=CellConfig, description="Image path: cells and which become fronts.")
+    portholes: PortholeConfig = Field(default_factory=PortholeConfig, description="Image path: round doors from a ring standing proud of a plane.")
     clutter: ClutterConfig = Field(default_factory=ClutterConfig, description="Image path: cluttered cells are no fronts.")
 
     @model_validator(mode="before")

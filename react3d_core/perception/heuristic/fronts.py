@@ -345,7 +345,8 @@ def _opening_sign(axis: np.ndarray, origin: np.ndarray, probe: np.ndarray, n_out
 def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]], r: FrontRulesConfig,
            side_hinged: bool = False) -> tuple[str, Articulation]:
     """Kind and joint from shape and handle. ``side_hinged``: the front is known to be a door hinged at a
-    side (a room door: its lever handle is horizontal, which would read as a drop door or a drawer)."""
+    side (a room door: its lever handle is horizontal, which would read as a drop door or a drawer; a porthole
+    door, as low as a deep drawer)."""
     z = np.array([0.0, 0.0, 1.0])
     cu, cv = 0.5 * sum(f.extent_u), 0.5 * sum(f.extent_v)
     plane_pt = f.center
@@ -363,7 +364,8 @@ def _joint(f: Front, hpts: np.ndarray | None, neighbours: list[tuple[Front, str]
     stacked = any(side == "vertical" for _, side in neighbours)  # a same-width front above/below: a stack
     if side_hinged:
         horizontal, stacked = False, False
-    if (horizontal and f.h <= r.drawer_max_h) or (hpts is None and f.h <= r.drawer_max_h and (f.w >= f.h or stacked)):
+    if not side_hinged and ((horizontal and f.h <= r.drawer_max_h)
+                            or (hpts is None and f.h <= r.drawer_max_h and (f.w >= f.h or stacked))):
         return "drawer", Articulation(joint_type="prismatic", axis=f.n_out, origin=centre, lower=0.0, upper=r.drawer_travel,
                                       limit_source="heuristic")
     # no flap lifts under a worktop, and no front taller than a flap or drop door swings about a horizontal axis

@@ -31,10 +31,13 @@ from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
 from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
 from .plane_surface import PlaneSurface, cast_surface, flat_surface
 from .planes import Plane, share_behind, vertical_planes
+from .portholes import find_portholes
 
 _MIN_CUT_SIDES = 2  # a handle-less cell cut out on this many sides is cut out by the plane's seams
 _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
 _EDGE_NEAR = 0.01  # m: a cell this close to the coverage's top or bottom row runs along its edge
+_PORTHOLE_COVERED = 0.5  # a cell's front covering this share of a porthole door is the plate around it
+_PORTHOLE_SPAN = 0.9  # a strip spanning this share of a porthole door's width is the plate
 
 
 @dataclass
@@ -438,6 +441,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     gridded: set[int] = set()  # fronts cut out by straight seams in a plane without tile-sized cells
     singles: set[int] = set()  # handle-less fronts cut on one side only (the others: the plane's outline)
     pieces: set[int] = set()  # handle-less fronts on the front of a piece standing free (``piece_front``)
+    round_doors: set[int] = set()  # porthole doors (``portholes``): kept, and hinged at a side
     one_cut = cfg.cells.single_cut or cfg.cells.piece_max_w > 0
     veto_evidence: list[VetoEvidence] = []
     for i, o in enumerate(orthos):
@@ -505,6 +509,17 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                 and fronts_share(mine, o, cov) >= cfg.cells.piece_front_share
                 and (not cfg.cells.piece_behind or stands_in_room(mesh, o.plane, cfg.room_wall))):
             pieces.update(id(f) for f in mine)
+        if cfg.portholes.enabled:
+            proud = (protrusion_map(o, surf, hc, 0.0, cfg.planes.offset_tol) if rays
+                     else protrusion_from_faces(o, centroids, mesh.face_normals, hc, 0.0, cfg.planes.offset_tol))
+            for box in find_portholes(proud, o.res, cfg.portholes):
+                door = _box_front(o, box, in_plane, cfg.portholes.face_depth, cfg.image.min_faces)
+                if door is None:
+                    continue
+                mine = [f for f in mine if _overlap(f, door) < _PORTHOLE_COVERED * door.w * door.h
+                        and not _plate_strip(f, door, cfg.portholes.plate_gap)]
+                mine.append(door)
+                round_doors.add(id(door))
         fronts += mine
     if not cfg.cells.single_cut:
         fronts = [f for f in fronts if id(f) not in singles or id(f) in pieces]
@@ -515,14 +530,14 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     # ``stack_min`` stacked cells of one width (a drawer pedestal with edge pulls); tiles and splash-backs
     # have no handles and, tiled, cells smaller than a front
     stacked = stacks(fronts, rules, cfg.cells.stack_min)
-    fronts = plain_fronts_kept(fronts, rules, gridded, stacked, singles, pieces)
+    fronts = plain_fronts_kept(fronts, rules, gridded, stacked, singles, pieces | round_doors)
     # ... but a handle-less panel that reaches down to the floor is wall (beside a room door, say): base
     # units stand on a plinth and room doors have handles; a stack's bottom drawer and a piece's fronts stay
     if cfg.image.plain_floor_gap > 0:
-        fronts = off_the_floor(fronts, floor_height(mesh, cfg.floor), cfg.image.plain_floor_gap, stacked | pieces)
+        fronts = off_the_floor(fronts, floor_height(mesh, cfg.floor), cfg.image.plain_floor_gap, stacked | pieces | round_doors)
     for f in fronts:
         hpts = f.handle_points if f.handle_points is not None and len(f.handle_points) else f.shadow_points
-        f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules)
+        f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules, side_hinged=id(f) in round_doors)
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, veto_evidence, cfg)})
     return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
@@ -780,3 +795,39 @@ def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray,
               extent_u=(float(u_a), float(u_b)), extent_v=(float(v_a), float(v_b)), faces=faces)
     f.handle_points = np.concatenate(hp) if hp else None
     return f
+
+
+def _box_front(o: Orthophoto, box: tuple[int, int, int, int], in_plane: np.ndarray, depth: tuple[float, float],
+               min_faces: int) -> Front | None:
+    """The front over grid box ``box`` (r0, r1, c0, c1) of ``o``'s plane: the faces whose (u, z, depth)
+    ``in_plane`` lie inside it and within ``depth`` of the plane; None with fewer than ``min_faces``."""
+    r0, r1, c0, c1 = box
+    p = o.plane
+    u_a, u_b = o.u0 + c0 * o.res, o.u0 + c1 * o.res
+    v_a, v_b = o.v_top - r1 * o.res, o.v_top - r0 * o.res
+    du, dv, dn = in_plane[:, 0], in_plane[:, 1], in_plane[:, 2]
+    faces = np.flatnonzero((du > u_a) & (du < u_b) & (dv > v_a) & (dv < v_b) & (dn > depth[0]) & (dn < depth[1]))
+    if len(faces) < min_faces:
+        return None
+    center = p.to_world(0.5 * (u_a + u_b), 0.5 * (v_a + v_b))
+    return Front(facet=-1, handle_facets=[], center=center, n_out=p.n.copy(), u=p.u.copy(),
+                 extent_u=(float(u_a), float(u_b)), extent_v=(float(v_a), float(v_b)), faces=faces)
+
+
+def _overlap(f: Front, g: Front) -> float:
+    """Area (m^2) where the rectangles of coplanar fronts ``f`` and ``g`` overlap, measured along ``g``'s axes."""
+    fu = float(f.center @ g.u)
+    ou = min(fu + f.w / 2, g.extent_u[1]) - max(fu - f.w / 2, g.extent_u[0])
+    ov = min(f.extent_v[1], g.extent_v[1]) - max(f.extent_v[0], g.extent_v[0])
+    return max(ou, 0.0) * max(ov, 0.0)
+
+
+def _plate_strip(f: Front, door: Front, gap: float) -> bool:
+    """``f`` is a strip of the plate around porthole ``door``: at least as wide as the door (``_PORTHOLE_SPAN``
+    of it), within ``gap`` above or below it. A drawer beside the porthole (detergent) is narrower; the
+    plate's strips between seams and the control panel are not fronts, whatever its knob and the drawer's
+    edge read as (a handle: free-standing tuning 311)."""
+    fu = float(f.center @ door.u)
+    span = min(fu + f.w / 2, door.extent_u[1]) - max(fu - f.w / 2, door.extent_u[0])
+    apart = max(f.extent_v[0] - door.extent_v[1], door.extent_v[0] - f.extent_v[1])
+    return span >= _PORTHOLE_SPAN * door.w and -_PORTHOLE_SPAN * door.h < apart <= gap
