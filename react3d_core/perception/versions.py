@@ -53,8 +53,6 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     (image.pane_seen, pane_seen_reach, pane_seen_max_cover, pane_speck, pane_gap)
 # 28: on a plane where at least two handles stand out of the scan, colour-only handle blobs are panel
 #     bevels and shading lines, not handles (handles.bar_plane_min, bar_share)
-# 29: a ring standing proud of a plane all round a door-sized circle is a porthole door hinged at a side; the
-#     plane's cells covering it and its plate's handle-less strips over and under it are no fronts (portholes)
-HEURISTIC_VERSION = "29"
+HEURISTIC_VERSION = "28"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
