@@ -304,6 +304,8 @@ DEFAULTS = {
     "perception.heuristic.image.seen_reach": 0.05,
     "perception.heuristic.image.rays_face_edge": 0.015,
     "perception.heuristic.image.modelled_share": 0.5,
+    "perception.heuristic.image.coverage_tilt_deg": 0.0,
+    "perception.heuristic.image.coverage_tilt_depth": 0.025,
     "perception.heuristic.image.coverage_close": 0.02,
     "perception.heuristic.image.outline_fill_px": 20,
     "perception.heuristic.image.min_faces": 4,

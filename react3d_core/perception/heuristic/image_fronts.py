@@ -124,12 +124,18 @@ def coarse_faces(mesh: TriMesh, faces: np.ndarray, edge: float) -> bool:
     return weighted_median(np.sqrt(2.0 * a), a) > edge
 
 
-def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: float) -> np.ndarray:
+def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: float, slab: float = 0.0,
+                        tilt_deg: float = 0.0) -> np.ndarray:
     """Grid pixels covered by the plane's own faces (centroids splatted, holes up to ``close`` m closed,
     fragments under ``min_area`` m² dropped): ``image.surface_rays`` off. Decimated scans' faces lie
-    farther apart than ``close``, so their planes come out mostly uncovered."""
+    farther apart than ``close``, so their planes come out mostly uncovered. With ``tilt_deg`` > 0 the
+    faces within ``slab`` m of the plane whose normals are tilted from its own by at most ``tilt_deg``
+    paint it too (``slab_faces``)."""
     h, w = o.n_views.shape
-    cen = mesh.face_centroids[o.plane.faces]
+    faces = o.plane.faces
+    if tilt_deg > 0:
+        faces = np.union1d(faces, slab_faces(mesh, o.plane, slab, tilt_deg))
+    cen = mesh.face_centroids[faces]
     c = np.floor((cen @ o.plane.u - o.u0) / o.res).astype(int)
     r = np.floor((o.v_top - cen[:, 2]) / o.res).astype(int)
     ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
@@ -143,6 +149,23 @@ def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: fl
     keep = np.zeros(n, bool)
     keep[1:] = stats[1:, cv2.CC_STAT_AREA] * o.res ** 2 >= min_area
     return keep[lab]
+
+
+def slab_faces(mesh: TriMesh, plane: Plane, slab: float, tilt_deg: float) -> np.ndarray:
+    """Faces whose centroids lie within ``slab`` m of ``plane`` and inside its extent, facing its way with
+    normals tilted from its normal by at most ``tilt_deg``.
+
+    Why: a plane holds the faces whose normals lie within ``planes.angle_tol_deg`` of its own. A fused
+    scan of a raised-panel or shaker front rounds its bevels and frame into a surface whose faces tilt
+    by 15-40 degrees, all within a centimetre or two of the front's plane, so only 25-40 % of such a
+    front was its plane's and its cell fell under ``cells.min_seen``. The worktop's top and the floor
+    face up, not out, so they stay out."""
+    cen, nrm = mesh.face_centroids, mesh.face_normals
+    p = plane
+    near = np.flatnonzero((np.abs(cen @ p.n - p.d) <= slab) & (nrm @ p.n >= np.cos(np.radians(tilt_deg))))
+    uu, vv = cen[near] @ p.u, cen[near, 2]
+    inside = ((uu >= p.extent_u[0]) & (uu <= p.extent_u[1]) & (vv >= p.extent_v[0]) & (vv <= p.extent_v[1]))
+    return near[inside]
 
 
 def seen_near(seen: np.ndarray, res: float, reach: float) -> np.ndarray:
@@ -458,6 +481,11 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
             cov = coverage_map(o, flat, cfg.planes.min_fragment_area, cfg.image.coverage_close)
         else:
             cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close)
+        # cells are cut on the plane's own coverage; whether a cell is covered is read with its tilted faces
+        cell_cov = cov
+        if not rays and cfg.image.coverage_tilt_deg > 0:
+            cell_cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close,
+                                           cfg.image.coverage_tilt_depth, cfg.image.coverage_tilt_deg)
         seen_at_plane = o.n_views > 0
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
         framing = pane_frame_map(cov, seen_at_plane if cfg.image.pane_seen else None, o.res, cfg.image.pane_speck,
@@ -494,7 +522,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         tiled = is_tiled(cells, cov, o.res, cfg.cells)
         mine: list[Front] = []
         for cell in cells:
-            f = _cell_front(o, cell, cov, clutter, in_plane, cfg, None,
+            f = _cell_front(o, cell, cell_cov, clutter, in_plane, cfg, None,
                             (thr, structure) if clut.cell_median else None, one_cut)
             if f is not None:
                 if f.handle_points is None:

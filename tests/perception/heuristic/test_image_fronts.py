@@ -16,7 +16,8 @@ from react3d_core.data.mesh import TriMesh
 from react3d_core.perception.heuristic.facets import planar_facets
 from react3d_core.perception.heuristic.front_cells import find_handles, split_cells
 from react3d_core.perception.heuristic.fronts import find_fronts
-from react3d_core.perception.heuristic.image_fronts import coarse_faces, find_image_fronts, modelled_surface
+from react3d_core.perception.heuristic.image_fronts import (coarse_faces, coverage_from_faces, find_image_fronts,
+                                                             modelled_surface, slab_faces)
 from react3d_core.perception.heuristic.orthophoto import ColourCalibration, Orthophoto, _nanmedian
 from react3d_core.perception.heuristic.plane_surface import PlaneSurface, cast_surface, flat_surface
 from react3d_core.perception.heuristic.planes import surface_samples, vertical_planes
@@ -872,3 +873,26 @@ def test_tall_unit_beside_a_base_run_splits_at_its_edge() -> None:
     off = HeuristicConfig(cells={"outline_step": 0.0})
     old = sorted((c for c in split_cells(o, cov, handles, off) if c.handles), key=lambda c: c.c0)
     assert any(c.c0 < 90 or c.r0 < 200 for c in old)  # without it a door's cell is not its own
+
+
+def test_tilted_faces_in_the_slab_cover_a_bevelled_front() -> None:
+    """Plane y = 0 facing -y (0.4 x 0.4 m, none of its own faces). 3 cm triangles: turned 20 degrees about z
+    (a bevel: within 30 degrees, in the slab), turned 40 degrees (too steep), facing up (a worktop's top),
+    facing -y 4 cm behind the plane (a seam's floor, beyond 2.5 cm), facing -y outside the plane's extent,
+    and facing +y (the back of a board). Only the bevel paints the coverage, and only with a tilt allowed."""
+    def tri(o: list[float], turn_deg: float = 0.0, up: bool = False) -> list[np.ndarray]:
+        s, t, p = 0.03, np.radians(turn_deg), np.array(o, float)
+        if up:
+            return [p, p + [s, 0, 0], p + [0, s, 0]]
+        return [p, p + [s * np.cos(t), s * np.sin(t), 0], p + [0, 0, s]]
+    tris = [tri([0.1, 0, 0.1], 20), tri([0.2, 0, 0.1], 40), tri([0.1, 0, 0.2], up=True), tri([0.2, 0.04, 0.2]),
+            tri([0.6, 0, 0.1]), tri([0.3, 0, 0.3])[::-1]]
+    m = TriMesh(np.concatenate(tris), np.arange(3 * len(tris)).reshape(-1, 3))
+    o = flat_ortho(np.zeros((100, 100, 3)))
+    assert slab_faces(m, o.plane, 0.025, 30.0).tolist() == [0]
+    assert slab_faces(m, o.plane, 0.025, 45.0).tolist() == [0, 1]
+    assert slab_faces(m, o.plane, 0.05, 30.0).tolist() == [0, 3]
+    assert not coverage_from_faces(o, m, 0.0, 0.0).any()  # the plane's own faces: none
+    cov = coverage_from_faces(o, m, 0.0, 0.0, 0.025, 30.0)
+    c = m.face_centroids[0]
+    assert cov.sum() == 1 and cov[int((o.v_top - c[2]) / o.res), int((c[0] - o.u0) / o.res)]
