@@ -339,6 +339,7 @@ class HandleConfig(StageConfig):
     seam_share: float = Field(0.9, ge=0, le=1, description="A blob with at least this share of its pixels on straight seam evidence longer than any handle is a piece of a seam, not a handle (a fused seam is 3-5 px wide; where only part of it passes the contrast it is a bar-sized blob). At 0.5 a RedKitchen bar beside a door seam went too (every 4th frame: 6 / 4 -> 5 / 5). 0: off.")
     bar_plane_min: int = Field(2, ge=0, description="On a plane where at least this many handles stand out of the scan (bar_share of their pixels on the surface in front of the plane), colour-only handles are panel bevels and shading lines, not handles (0: off).")
     bar_share: float = Field(0.5, ge=0, le=1, description="... share of a handle's pixels on that surface that makes it a handle in the scan.")
+    bar_reach: float = Field(0.0, ge=0, description="With bar_plane_min: only colour-only handles within this distance (m) of a bar go (0: every one on the plane).")
 
 
 class CellConfig(StageConfig):

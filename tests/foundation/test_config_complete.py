@@ -446,6 +446,7 @@ DEFAULTS = {
     "perception.heuristic.handles.seam_share": 0.9,
     "perception.heuristic.handles.bar_plane_min": 2,
     "perception.heuristic.handles.bar_share": 0.5,
+    "perception.heuristic.handles.bar_reach": 0.0,
     "perception.heuristic.cells.min_side": 0.1,
     "perception.heuristic.cells.max_split_depth": 6,
     "perception.heuristic.cells.outline_step": 0.5,

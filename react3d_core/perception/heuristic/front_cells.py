@@ -208,13 +208,15 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
     if protrusion is not None and not bars_only:
-        out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share)
+        out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share, p.bar_reach / o.res)
     return out
 
 
-def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, share: float) -> list[Handle]:
+def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, share: float,
+                        reach_px: float = 0.0) -> list[Handle]:
     """``handles`` less the colour-only ones when at least ``min_bars`` of them (0: never) stand out of the
-    scan: ``share`` or more of their pixels on ``bars`` (the surface in front of the plane).
+    scan: ``share`` or more of their pixels on ``bars`` (the surface in front of the plane). With
+    ``reach_px`` > 0 only a colour-only handle whose box lies within that many pixels of a bar's box goes.
 
     Why: a plane whose handles the scan holds as bars shows its handles there; a raised panel's bevels
     and the shading along its frame are straight colour lines of a bar's size beside them (a
@@ -226,7 +228,16 @@ def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, 
     on_bar = [float(bars[h.pixels[:, 1], h.pixels[:, 0]].mean()) >= share for h in handles]
     if sum(on_bar) < min_bars:
         return handles
-    return [h for h, b in zip(handles, on_bar) if b]
+    if reach_px <= 0:
+        return [h for h, b in zip(handles, on_bar) if b]
+    boxes = np.array([h.box for h, b in zip(handles, on_bar) if b], float)
+
+    def near_bar(h: Handle) -> bool:
+        dx = np.maximum(0.0, np.maximum(boxes[:, 0] - h.box[2], h.box[0] - boxes[:, 2]))
+        dy = np.maximum(0.0, np.maximum(boxes[:, 1] - h.box[3], h.box[1] - boxes[:, 3]))
+        return bool((np.hypot(dx, dy) <= reach_px).any())
+
+    return [h for h, b in zip(handles, on_bar) if b or not near_bar(h)]
 
 
 def _is_knob(w: int, h: int, area: int, res: float, p: HandleConfig) -> bool:

@@ -28,6 +28,22 @@ def test_bars_outrank_colour_by_hand() -> None:
     assert bars_outrank_colour([a, b, c], bars, 2, 0.6) == [a, b, c]
 
 
+def test_bars_outrank_colour_only_near_a_bar() -> None:
+    """Bars A (rows 0) and B (row 5) on cols 0-3; colour-only C at row 10 (4 px below B's box: rows 6-9 lie
+    between) and D at row 40 (34 px below). With reach 5 px only C goes (gap 4 <= 5); D, 34 px from B,
+    stays; with reach 4 C still goes (4 <= 4), with reach 3 it stays; reach 0 drops both, as the plane-wide
+    rule does."""
+    bars = np.zeros((50, 20), bool)
+    a, b = _handle(0, 0, 4, 1), _handle(0, 5, 4, 6)
+    c, d = _handle(0, 10, 4, 11), _handle(0, 40, 4, 41)
+    bars[0, 0:4] = True
+    bars[5, 0:4] = True
+    assert bars_outrank_colour([a, b, c, d], bars, 2, 0.5, 5.0) == [a, b, d]
+    assert bars_outrank_colour([a, b, c, d], bars, 2, 0.5, 4.0) == [a, b, d]
+    assert bars_outrank_colour([a, b, c, d], bars, 2, 0.5, 3.0) == [a, b, c, d]
+    assert bars_outrank_colour([a, b, c, d], bars, 2, 0.5, 0.0) == [a, b]
+
+
 def _two_raised_panel_doors() -> tuple[np.ndarray, np.ndarray]:
     """A 0.8 x 0.7 m plane (200 x 175 px at 4 mm) of two doors side by side, each with a pale vertical bar
     handle 16 x 1.6 cm that stands out of the scan (cols 85-88 and 111-114, rows 40-79), and a dark bevel line
