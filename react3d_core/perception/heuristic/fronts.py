@@ -54,6 +54,12 @@ class Front:
         return self.extent_v[1] - self.extent_v[0]
 
 
+def u_overlap(f: Front, g: Front) -> float:
+    """How far ``g``'s outline overlaps ``f``'s along ``f``'s horizontal axis (< 0: the gap between them)."""
+    c = float(g.center @ f.u)
+    return min(c + g.w / 2, f.extent_u[1]) - max(c - g.w / 2, f.extent_u[0])
+
+
 def _frame(n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     nh = np.array([n[0], n[1], 0.0])
     nh /= max(np.linalg.norm(nh), 1e-12)

@@ -25,7 +25,7 @@ from ...data.mesh import TriMesh
 from ...geometry import weighted_median
 from ...raster import Rasterizer
 from .front_cells import Cell, Handle, find_handles, off_background, off_local, off_threshold, split_cells
-from .fronts import Front, _joint, _neighbours, doors_in_rows
+from .fronts import Front, _joint, _neighbours, doors_in_rows, u_overlap
 from .line_evidence import LineSupport, line_support
 from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
 from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
@@ -538,8 +538,10 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                 and (not cfg.cells.piece_behind or stands_in_room(mesh, o.plane, cfg.room_wall))):
             pieces.update(id(f) for f in mine)
         if cfg.portholes.enabled:
-            proud = (protrusion_map(o, surf, hc, 0.0, cfg.planes.offset_tol) if rays
-                     else protrusion_from_faces(o, centroids, mesh.face_normals, hc, 0.0, cfg.planes.offset_tol))
+            # the ring stands out of the plate's plane, not of the surface around it (the ring itself)
+            proud = bars if win == 0.0 else (
+                protrusion_map(o, surf, hc, 0.0, cfg.planes.offset_tol) if rays
+                else protrusion_from_faces(o, centroids, mesh.face_normals, hc, 0.0, cfg.planes.offset_tol))
             for box in find_portholes(proud, o.res, cfg.portholes):
                 door = _box_front(o, box, in_plane, cfg.portholes.face_depth, cfg.image.min_faces)
                 if door is None:
@@ -844,10 +846,8 @@ def _box_front(o: Orthophoto, box: tuple[int, int, int, int], in_plane: np.ndarr
 
 def _overlap(f: Front, g: Front) -> float:
     """Area (m^2) where the rectangles of coplanar fronts ``f`` and ``g`` overlap, measured along ``g``'s axes."""
-    fu = float(f.center @ g.u)
-    ou = min(fu + f.w / 2, g.extent_u[1]) - max(fu - f.w / 2, g.extent_u[0])
     ov = min(f.extent_v[1], g.extent_v[1]) - max(f.extent_v[0], g.extent_v[0])
-    return max(ou, 0.0) * max(ov, 0.0)
+    return max(u_overlap(g, f), 0.0) * max(ov, 0.0)
 
 
 def _plate_strip(f: Front, door: Front, gap: float) -> bool:
@@ -855,7 +855,6 @@ def _plate_strip(f: Front, door: Front, gap: float) -> bool:
     of it), within ``gap`` above or below it. A drawer beside the porthole (detergent) is narrower; the
     plate's strips between seams and the control panel are not fronts, whatever its knob and the drawer's
     edge read as (a handle: free-standing tuning 311)."""
-    fu = float(f.center @ door.u)
-    span = min(fu + f.w / 2, door.extent_u[1]) - max(fu - f.w / 2, door.extent_u[0])
+    span = u_overlap(door, f)
     apart = max(f.extent_v[0] - door.extent_v[1], door.extent_v[0] - f.extent_v[1])
     return span >= _PORTHOLE_SPAN * door.w and -_PORTHOLE_SPAN * door.h < apart <= gap

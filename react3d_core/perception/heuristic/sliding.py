@@ -14,13 +14,7 @@ import numpy as np
 
 from ...config.heuristic import SlidingConfig
 from ...data.parts import Articulation
-from .fronts import Front
-
-
-def _u_overlap(f: Front, g: Front) -> float:
-    """How far ``g``'s outline overlaps ``f``'s along ``f``'s horizontal axis (< 0: the gap between them)."""
-    c = float(g.center @ f.u)
-    return min(c + g.w / 2, f.extent_u[1]) - max(c - g.w / 2, f.extent_u[0])
+from .fronts import Front, u_overlap
 
 
 def sliding_partner(f: Front, fronts: list[Front], r: SlidingConfig) -> Front | None:
@@ -36,7 +30,7 @@ def sliding_partner(f: Front, fronts: list[Front], r: SlidingConfig) -> Front | 
         hv = min(g.extent_v[1], f.extent_v[1]) - max(g.extent_v[0], f.extent_v[0])
         if hv < r.min_height_overlap * min(f.h, g.h) or abs(f.h - g.h) > (1 - r.min_height_overlap) * max(f.h, g.h):
             continue
-        ov = _u_overlap(f, g)
+        ov = u_overlap(f, g)
         if not (-r.max_gap <= ov <= min(r.max_overlap, 0.5 * min(f.w, g.w))):
             continue
         if ov > best_ov:
@@ -58,7 +52,7 @@ def mark_sliding(fronts: list[Front], rules: SlidingConfig = SlidingConfig()) ->
         centre = np.array([centre[0], centre[1], 0.5 * sum(f.extent_v)])
         f.kind = "sliding"
         f.articulation = Articulation(joint_type="prismatic", axis=towards * f.u, origin=centre, lower=0.0,
-                                      upper=max(rules.min_travel, f.w - max(0.0, _u_overlap(f, g))),
+                                      upper=max(rules.min_travel, f.w - max(0.0, u_overlap(f, g))),
                                       limit_source="heuristic")
         n += 1
     return n
