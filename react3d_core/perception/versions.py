@@ -57,6 +57,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     plane's cells covering it and its plate's handle-less strips over and under it are no fronts (portholes)
 # 30: a colour-only handle with one long side on the plane's surface but seen by no view is the edge of what hides
 #     the plane, not a handle (handles.hidden_side)
-HEURISTIC_VERSION = "30"
+# 31: a piece's handle-less fronts need its plane seen: the views see cells.piece_seen of its coverage
+HEURISTIC_VERSION = "31"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -464,6 +464,7 @@ DEFAULTS = {
     "perception.heuristic.cells.piece_behind": True,
     "perception.heuristic.cells.piece_fill": 0.6,
     "perception.heuristic.cells.piece_front_share": 0.5,
+    "perception.heuristic.cells.piece_seen": 0.8,
     "perception.heuristic.cells.mesh_split_seams": True,
     "perception.heuristic.portholes.enabled": True,
     "perception.heuristic.portholes.diameter": (0.3, 0.6),
