@@ -55,6 +55,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     bevels and shading lines, not handles (handles.bar_plane_min, bar_share)
 # 29: a ring standing proud of a plane all round a door-sized circle is a porthole door hinged at a side; the
 #     plane's cells covering it and its plate's handle-less strips over and under it are no fronts (portholes)
-HEURISTIC_VERSION = "29"
+# 30: a colour-only handle with one long side on the plane's surface but seen by no view is the edge of what hides
+#     the plane, not a handle (handles.hidden_side)
+# 31: a piece's handle-less fronts need its plane seen: the views see cells.piece_seen of its coverage
+HEURISTIC_VERSION = "31"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -184,7 +184,7 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
     n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=CONNECTIVITY)
     out = []
-    seams = None
+    seams = hidden = None
     for j in range(1, n):
         x, y, w, h, area = stats[j]
         long_, short = max(w, h) * o.res, min(w, h) * o.res
@@ -205,11 +205,33 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
             continue
         if p.side_cover > 0 and min(_side_cover(ref, (x, y, w, h), pad)) < p.side_cover:
             continue
+        if p.hidden_side > 0 and not bars_only:
+            hidden = coverage.astype(bool) & ~valid if hidden is None else hidden
+            if _at_hidden_edge(hidden, protrusion, lab[y:y + h, x:x + w] == j, (x, y, w, h), pad, p):
+                continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
     if protrusion is not None and not bars_only:
         out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share, p.bar_reach / o.res)
     return out
+
+
+def _at_hidden_edge(hidden: np.ndarray, protrusion: np.ndarray | None, mine: np.ndarray,
+                    box: tuple[int, int, int, int], pad: int, p: HandleConfig) -> bool:
+    """Whether a blob (``mine``: its pixels in its ``box`` x, y, w, h) is colour only (under ``p.bar_share`` of it
+    on ``protrusion``) and has, along a long side, ``p.hidden_side`` or more of the ``pad``-wide band ``hidden``:
+    on the plane's surface (its coverage) but seen by no view.
+
+    Why: there the plane is hidden from every view by something in front of it (a chair, a box, the next
+    piece), and the colour along that edge is the edge of whatever hides it, or the plane's own edge lit or
+    shaded: the sides and backs of pieces standing free became doors at such blobs (free-standing tuning,
+    laser scans: a sideboard's back and side, a box's side, a turned piece's back). A handle's scanning
+    shadow is no such band: the scan lacks the surface there, so it is not ``coverage``; and a handle the
+    scan holds stands out of the plane."""
+    x, y, w, h = box
+    if protrusion is not None and float(protrusion[y:y + h, x:x + w][mine].mean()) >= p.bar_share:
+        return False
+    return max(_side_cover(hidden, box, pad)) >= p.hidden_side
 
 
 def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, share: float,

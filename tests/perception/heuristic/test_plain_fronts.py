@@ -9,7 +9,8 @@ import numpy as np
 from react3d_core.config.heuristic import CellConfig, FrontRulesConfig, HeuristicConfig
 from react3d_core.perception.heuristic.front_cells import Cell, split_cells
 from react3d_core.perception.heuristic.fronts import Front, _joint
-from react3d_core.perception.heuristic.image_fronts import fronts_share, is_tiled, piece_front, plain_fronts_kept, stacks
+from react3d_core.perception.heuristic.image_fronts import (fronts_share, is_tiled, piece_front, piece_of_fronts, plain_fronts_kept,
+                                                           seen_share, stacks)
 from tests.perception.heuristic.flat_orthos import flat_ortho
 
 N = np.array([0.0, -1.0, 0.0])      # facing -y; u = z x n = (1, 0, 0)
@@ -171,3 +172,21 @@ def test_bright_rows_cut_a_handle_less_chest_into_its_drawers() -> None:
     assert len(cells) == 3
     assert [c.c1 - c.c0 for c in cells] == [150, 150, 150]
     assert [(c.r0, c.r1) for c in cells] == [(0, 34), (35, 69), (70, 105)]  # cut on the bright rows 34, 69
+
+
+def test_a_piece_is_what_the_views_see() -> None:
+    """At 1 cm per px: a 0.60 x 0.84 m panel, all of it in the scan, cut by one row at z 0.60 into a 0.60 x 0.60 m
+    handle-less "front" below (share 3600 / 5040 = 0.71 of the plane). Seen all over it is a piece's front. A
+    sideboard's side behind a chair: the views see only the top 24 rows (1440 / 5040 = 0.286 of it) and the
+    same cut (the chair's edge) -- no piece with ``piece_seen`` 0.8 (the default); with 0 (off) it is one."""
+    cov = np.ones((84, 60), bool)
+    front = [_front(0.0, 0.60, 0.0, 0.60)]
+    seen = flat_ortho(np.ones((84, 60, 3)), 0.01)
+    assert seen_share(seen, cov) == 1.0
+    assert piece_of_fronts(front, seen, cov, HeuristicConfig())
+    hidden = flat_ortho(np.ones((84, 60, 3)), 0.01)
+    hidden.n_views[24:, :] = 0
+    assert abs(seen_share(hidden, cov) - 1440 / 5040) < 1e-9
+    assert not piece_of_fronts(front, hidden, cov, HeuristicConfig())
+    assert piece_of_fronts(front, hidden, cov, HeuristicConfig(cells={"piece_seen": 0.0}))
+    assert seen_share(hidden, np.zeros((84, 60), bool)) == 0.0

@@ -1,0 +1,54 @@
+"""Colour at the edge of what the views see is no handle (front_cells._at_hidden_edge, handles.hidden_side)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from react3d_core.config.heuristic import HeuristicConfig
+from react3d_core.perception.heuristic.front_cells import find_handles
+from tests.perception.heuristic.flat_orthos import flat_ortho
+
+_H, _W = 150, 200  # 0.6 x 0.8 m at 4 mm
+_BAR = (slice(70, 76), slice(60, 120))  # a dark 24 x 2.4 cm blob: a bar handle's size
+
+
+def _panel() -> np.ndarray:
+    """A pale plain panel with the dark blob of ``_BAR`` across its middle."""
+    rng = np.random.default_rng(5)
+    img = np.full((_H, _W, 3), 0.8, np.float32) + rng.normal(0, 0.003, (_H, _W, 3)).astype(np.float32)
+    img[_BAR] = 0.2
+    return img
+
+
+def test_colour_along_a_hidden_band_is_no_handle() -> None:
+    """The panel's surface is all in the scan (coverage everywhere), but no view sees it below the blob
+    (rows 76 on: a chair in front of a sideboard's side). Off, the blob is a handle; with hidden_side 0.5
+    (the default) its lower side's 2 cm band is hidden surface and it goes. Seen all round, it stays."""
+    o = flat_ortho(_panel())
+    o.n_views[76:, :] = 0
+    cov = np.ones((_H, _W), bool)
+    off, on = HeuristicConfig(handles={"hidden_side": 0.0}), HeuristicConfig()
+    assert len(find_handles(o, cov, off)) == 1
+    assert find_handles(o, cov, on) == []
+    assert len(find_handles(flat_ortho(_panel()), cov, on)) == 1
+
+
+def test_hidden_share_of_a_side_hand_computed() -> None:
+    """Hidden surface under part of the blob only: under cols 60-84 (25 of its 60 px: 0.42 of the band) it
+    stays a handle, under cols 60-94 (35 px: 0.58) it goes (hidden_side 0.5)."""
+    cov = np.ones((_H, _W), bool)
+    for c1, kept in ((85, True), (95, False)):
+        o = flat_ortho(_panel())
+        o.n_views[76:, 60:c1] = 0
+        assert (len(find_handles(o, cov, HeuristicConfig())) == 1) == kept
+
+
+def test_a_bar_the_scan_holds_stays_beside_a_hidden_band() -> None:
+    """A blob standing out of the scan (on the protrusion map) is a handle the scan holds, whatever hides the
+    plane beside it."""
+    o = flat_ortho(_panel())
+    o.n_views[76:, :] = 0
+    cov = np.ones((_H, _W), bool)
+    bars = np.zeros((_H, _W), bool)
+    bars[_BAR] = True
+    assert len(find_handles(o, cov, HeuristicConfig(), protrusion=bars)) == 1
