@@ -55,6 +55,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     bevels and shading lines, not handles (handles.bar_plane_min, bar_share)
 # 29: a ring standing proud of a plane all round a door-sized circle is a porthole door hinged at a side; the
 #     plane's cells covering it and its plate's handle-less strips over and under it are no fronts (portholes)
-HEURISTIC_VERSION = "29"
+# 30: panes count as covered in a cell's coverage test as well as in its cut (image.pane_cell_cover)
+HEURISTIC_VERSION = "30"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -310,6 +310,7 @@ DEFAULTS = {
     "perception.heuristic.image.outline_fill_px": 20,
     "perception.heuristic.image.min_faces": 4,
     "perception.heuristic.image.pane_frame": 0.035,
+    "perception.heuristic.image.pane_cell_cover": True,
     "perception.heuristic.image.pane_frame_cover": 0.9,
     "perception.heuristic.image.pane_min_area": 0.01,
     "perception.heuristic.image.pane_min_side": 0.1,

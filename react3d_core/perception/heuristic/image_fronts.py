@@ -495,6 +495,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                              cfg.image.pane_min_fill)
         if panes.any():
             cov = cov | panes
+            if cfg.image.pane_cell_cover:  # a glass door's cell is its frame and its pane, not the ring alone
+                cell_cov = cell_cov | panes
             if cfg.image.pane_fill:
                 fill_panes(o, panes, cfg.image.pane_frame, cfg.image.pane_edge)
         diff = off_background(o, hc)
