@@ -58,6 +58,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 30: a colour-only handle with one long side on the plane's surface but seen by no view is the edge of what hides
 #     the plane, not a handle (handles.hidden_side)
 # 31: a piece's handle-less fronts need its plane seen: the views see cells.piece_seen of its coverage
-HEURISTIC_VERSION = "31"
+# 32: panes count as covered in a cell's coverage test as well as in its cut (image.pane_cell_cover)
+HEURISTIC_VERSION = "32"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

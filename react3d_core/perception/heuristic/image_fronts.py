@@ -216,8 +216,25 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
     return keep[lab]
 
 
+def seen_rim(seen: np.ndarray, res: float, depth: float) -> np.ndarray:
+    """What ``seen`` marks within ``depth`` (m) of the first seen pixel from the top and from the bottom of
+    each column: the plane's top and bottom edges as the views see them.
+
+    Why: on a TSDF scan a cupboard's top rail lies on the fused box's rounded top edge, outside the plane's
+    coverage and farther from it than the views' reach, so its pane ran out of the plane over the top."""
+    r = int(round(depth / res))
+    h = seen.shape[0]
+    if r <= 0 or not seen.any():
+        return np.zeros(seen.shape, bool)
+    rows = np.arange(h)[:, None]
+    cols = seen.any(0)
+    top = np.where(cols, seen.argmax(0), h)
+    bottom = np.where(cols, h - 1 - seen[::-1].argmax(0), -1)
+    return seen & ((rows < top + r) | (rows > bottom - r))
+
+
 def pane_frame_map(cov: np.ndarray, seen: np.ndarray | None, res: float, speck: float, gap: float,
-                   reach: float | None = None, max_cover: float = 1.0) -> np.ndarray:
+                   reach: float | None = None, max_cover: float = 1.0, rim: float = 0.0) -> np.ndarray:
     """What may frame a pane: the plane's coverage, joined with ``seen`` (what the views see at the
     plane's depth) when given, with covered strokes and specks thinner than ``speck`` (m) taken off, then
     gaps up to ``gap`` (m) closed.
@@ -238,6 +255,8 @@ def pane_frame_map(cov: np.ndarray, seen: np.ndarray | None, res: float, speck: 
         if near.any() and (cov & near).sum() >= max_cover * near.sum():
             return cov.copy()
         out |= near.astype(np.uint8)
+        if rim > 0:  # a rail on the box's rounded edge: seen at the plane's depth, at the plane's edge
+            out |= seen_rim(seen, res, rim).astype(np.uint8)
     k = int(round(speck / res)) | 1  # odd: an even kernel shifts what it keeps by a pixel
     if k >= MIN_KERNEL:
         out = cv2.morphologyEx(out, cv2.MORPH_OPEN, np.ones((k, k), np.uint8))
@@ -489,12 +508,15 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         seen_at_plane = o.n_views > 0
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
         framing = pane_frame_map(cov, seen_at_plane if cfg.image.pane_seen else None, o.res, cfg.image.pane_speck,
-                                 cfg.image.pane_gap, cfg.image.pane_seen_reach, cfg.image.pane_seen_max_cover)
+                                 cfg.image.pane_gap, cfg.image.pane_seen_reach, cfg.image.pane_seen_max_cover,
+                                 cfg.image.pane_seen_rim)
         panes = framed_panes(framing, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
                              cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
                              cfg.image.pane_min_fill)
         if panes.any():
             cov = cov | panes
+            if cfg.image.pane_cell_cover:  # a glass door's cell is its frame and its pane, not the ring alone
+                cell_cov = cell_cov | panes
             if cfg.image.pane_fill:
                 fill_panes(o, panes, cfg.image.pane_frame, cfg.image.pane_edge)
         diff = off_background(o, hc)

@@ -175,3 +175,35 @@ def test_a_whole_scan_surface_frames_panes_alone():
     assert np.array_equal(pane_frame_map(cov, seen, RES, 0.02, 0.08, reach=0.035, max_cover=0.9), cov)
     ragged = pane_frame_map(cov, seen, RES, 0.02, 0.08, reach=0.035, max_cover=1.0)  # no bound: joined
     assert ragged[100:106, 100:109].all() and not ragged[100:106, 112:148].any()
+
+
+def _cupboard_without_top_rail(rail_px: int) -> tuple[np.ndarray, np.ndarray]:
+    """A glass door on a TSDF plane (4 mm px): the views see its 6 cm stiles and bottom rail, the coverage
+    holds a ragged 3 cm strip of each (rows 22-160: under 90 % of what the views see near it), and the
+    views see a top rail ``rail_px`` tall from row 10 whose middle lies farther than their 3.5 cm reach
+    from the coverage (it lies on the box's rounded top edge)."""
+    cov = np.zeros((200, 140), bool)
+    cov[22:160, 24:31] = cov[22:160, 109:116] = cov[149:156, 20:120] = True
+    seen = np.zeros_like(cov)
+    seen[10:160, 20:35] = seen[10:160, 105:120] = seen[145:160, 20:120] = True
+    seen[10:10 + rail_px, 20:120] = True
+    return cov, seen
+
+
+def test_a_top_rail_the_views_see_at_the_planes_edge_frames_the_pane():
+    from react3d_core.perception.heuristic.image_fronts import pane_frame_map, seen_rim
+
+    cov, seen = _cupboard_without_top_rail(rail_px=13)  # a 5 cm rail
+
+    def panes(rim: float, c: np.ndarray = cov, s: np.ndarray = seen) -> np.ndarray:
+        framing = pane_frame_map(c, s, RES, 0.02, 0.08, 0.035, 0.9, rim)
+        return framed_panes(framing, RES, 0.035, 0.9, 0.01, 3, 0.1, 0.02, 0.8)
+
+    rim = seen_rim(seen, RES, 0.035)
+    assert rim[10:19, 20:120].all() and not rim[19:140, 35:105].any() and rim[151:160, 20:120].all()
+    assert not panes(0.0).any()  # the hole runs out over the top: no pane
+    p = panes(0.035)
+    assert p[60:140, 40:100].all() and not p[:15].any() and not p[:, :30].any()
+    # a carcass board's edge (1.6 cm, thinner than pane_speck) above an open shelf frames nothing
+    cov, seen = _cupboard_without_top_rail(rail_px=4)
+    assert not panes(0.035, cov, seen).any()

@@ -896,3 +896,32 @@ def test_tilted_faces_in_the_slab_cover_a_bevelled_front() -> None:
     cov = coverage_from_faces(o, m, 0.0, 0.0, 0.025, 30.0)
     c = m.face_centroids[0]
     assert cov.sum() == 1 and cov[int((o.v_top - c[2]) / o.res), int((c[0] - o.u0) / o.res)]
+
+
+def test_glass_doors_cells_count_their_panes_as_covered() -> None:
+    """The two-door run with a 40 x 50 cm pane in each door (no mesh there: the views see the wall behind):
+    each door's own surface is its 10 cm frame, 52 % of it, under cells.min_seen. The panes are framed
+    holes, so the doors' cells count them as covered and both doors are found; with the panes' coverage
+    left out of the cells' test (or no panes) neither is."""
+    mesh, frames, images = _seamless_cabinet_scene()
+    cen = mesh.face_centroids
+    in_pane = np.zeros(mesh.n_faces, bool)
+    for x0 in (0.1, 0.7):
+        in_pane |= (np.abs(cen[:, 1]) < 1e-6) & (cen[:, 0] > x0) & (cen[:, 0] < x0 + 0.4) & (cen[:, 2] > 0.2) & (cen[:, 2] < 0.7)
+    glass = TriMesh(mesh.vertices, mesh.faces[~in_pane], mesh.colors)
+    caster = RayCaster(glass)
+    rng = np.random.default_rng(1)
+    W, H = 480, 360
+    images = {f.frame_id: caster.rgb(caster.cast(f.intrinsics.K, f.c2w, W, H), rng) for f in frames}
+
+    def fronts(cfg: HeuristicConfig) -> list:
+        res = find_image_fronts(glass, frames, Rasterizer(glass), lambda f: images[f.frame_id], cfg)
+        return sorted(res.fronts, key=lambda f: f.center[0])
+
+    found = fronts(HeuristicConfig())
+    assert len(found) == 2, [(np.round(f.center, 2), f.w, f.h) for f in found]
+    for f, cx in zip(found, (0.3, 0.9)):
+        assert abs(f.center[0] - cx) < 0.04
+        assert abs(f.w - 0.6) < 0.06 and abs(f.h - 0.7) < 0.05
+    assert fronts(HeuristicConfig(image={"pane_cell_cover": False})) == []
+    assert fronts(HeuristicConfig(image={"pane_frame": 0.0})) == []
