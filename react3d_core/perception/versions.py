@@ -59,6 +59,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     the plane, not a handle (handles.hidden_side)
 # 31: a piece's handle-less fronts need its plane seen: the views see cells.piece_seen of its coverage
 # 32: panes count as covered in a cell's coverage test as well as in its cut (image.pane_cell_cover)
-HEURISTIC_VERSION = "32"
+# 33: a piece is seen where its coverage lies within image.seen_reach of a seen pixel (a glass door's frame
+#     between depth edges counted unseen, and a glass cabinet was no piece)
+HEURISTIC_VERSION = "33"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -639,18 +639,21 @@ def piece_of_fronts(fronts: Sequence[Front], o: Orthophoto, cov: np.ndarray, cfg
     return (all(f.handle_points is None for f in fronts)
             and piece_front(cov, o.res, cc.piece_max_w, cfg.fronts.max_h, cc.piece_fill)
             and fronts_share(fronts, o, cov) >= cc.piece_front_share
-            and seen_share(o, cov) >= cc.piece_seen)
+            and seen_share(o, cov, cfg.image.seen_reach) >= cc.piece_seen)
 
 
-def seen_share(o: Orthophoto, cov: np.ndarray) -> float:
-    """Share of a plane's coverage ``cov`` that some view sees at the plane's depth (``o.n_views``).
+def seen_share(o: Orthophoto, cov: np.ndarray, reach: float = 0.0) -> float:
+    """Share of a plane's coverage ``cov`` that some view sees at the plane's depth (``o.n_views``), or lies
+    within ``reach`` m of a pixel one sees (``seen_near``).
 
     Why: a piece's front is what one looks at; its side or back stands against a wall or behind a chair,
     where the scan may hold the panel whole (a laser scan) but the views see little of it, and a strip of
     what hides it cuts the panel into a "front" (free-standing tuning 305: a sideboard's side seen 31 %,
-    307: a chest freezer's side 72 %; true pieces' fronts 94 % and more)."""
+    307: a chest freezer's side 72 %; true pieces' fronts 94 % and more). ``reach`` gives back the outlines
+    the depth-edge erosion took off every view: a glass door's frame is a 10 cm strip between depth edges,
+    seen by no view at the plane's depth over most of it (a two-door glass cabinet: 39 % of its frames)."""
     total = int(cov.sum())
-    return float(((o.n_views > 0) & cov).sum()) / total if total else 0.0
+    return float((seen_near(o.n_views > 0, o.res, reach) & cov).sum()) / total if total else 0.0
 
 
 def is_tiled(cells: Sequence[Cell], cov: np.ndarray, res: float, cc: CellConfig) -> bool:
