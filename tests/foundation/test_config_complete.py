@@ -434,7 +434,7 @@ DEFAULTS = {
     "perception.heuristic.handles.side_band": 0.02,
     "perception.heuristic.handles.around_cover": 0.4,
     "perception.heuristic.handles.side_cover": 0.4,
-    "perception.heuristic.handles.hidden_side": 0.5,
+    "perception.heuristic.handles.hidden_side": 0.0,
     "perception.heuristic.handles.protrusion_depth": (0.012, 0.09),
     "perception.heuristic.handles.protrusion_min_cos": 0.5,
     "perception.heuristic.handles.protrusion_from_surface": True,

@@ -22,12 +22,12 @@ def _panel() -> np.ndarray:
 
 def test_colour_along_a_hidden_band_is_no_handle() -> None:
     """The panel's surface is all in the scan (coverage everywhere), but no view sees it below the blob
-    (rows 76 on: a chair in front of a sideboard's side). Off, the blob is a handle; with hidden_side 0.5
-    (the default) its lower side's 2 cm band is hidden surface and it goes. Seen all round, it stays."""
+    (rows 76 on: a chair in front of a sideboard's side). Off (the default), the blob is a handle; with
+    hidden_side 0.5 its lower side's 2 cm band is hidden surface and it goes. Seen all round, it stays."""
     o = flat_ortho(_panel())
     o.n_views[76:, :] = 0
     cov = np.ones((_H, _W), bool)
-    off, on = HeuristicConfig(handles={"hidden_side": 0.0}), HeuristicConfig()
+    off, on = HeuristicConfig(), HeuristicConfig(handles={"hidden_side": 0.5})
     assert len(find_handles(o, cov, off)) == 1
     assert find_handles(o, cov, on) == []
     assert len(find_handles(flat_ortho(_panel()), cov, on)) == 1
@@ -40,7 +40,7 @@ def test_hidden_share_of_a_side_hand_computed() -> None:
     for c1, kept in ((85, True), (95, False)):
         o = flat_ortho(_panel())
         o.n_views[76:, 60:c1] = 0
-        assert (len(find_handles(o, cov, HeuristicConfig())) == 1) == kept
+        assert (len(find_handles(o, cov, HeuristicConfig(handles={"hidden_side": 0.5}))) == 1) == kept
 
 
 def test_a_bar_the_scan_holds_stays_beside_a_hidden_band() -> None:
@@ -51,4 +51,4 @@ def test_a_bar_the_scan_holds_stays_beside_a_hidden_band() -> None:
     cov = np.ones((_H, _W), bool)
     bars = np.zeros((_H, _W), bool)
     bars[_BAR] = True
-    assert len(find_handles(o, cov, HeuristicConfig(), protrusion=bars)) == 1
+    assert len(find_handles(o, cov, HeuristicConfig(handles={"hidden_side": 0.5}), protrusion=bars)) == 1
