@@ -62,6 +62,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 33: a piece is seen where its coverage lies within image.seen_reach of a seen pixel (a glass door's frame
 #     between depth edges counted unseen, and a glass cabinet was no piece)
 # 34: handles.hidden_side off by default (it cost RedKitchen three fronts)
-HEURISTIC_VERSION = "34"
+# 35: a sliver cell between two wider cells of its rows is the stile where two doors meet: cut down its
+#     middle into its neighbours, with its handle halves (cells.sliver_max)
+HEURISTIC_VERSION = "35"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -454,6 +454,8 @@ DEFAULTS = {
     "perception.heuristic.cells.max_split_depth": 6,
     "perception.heuristic.cells.outline_step": 0.5,
     "perception.heuristic.cells.edge_strip": 0.2,
+    "perception.heuristic.cells.sliver_max": 0.13,
+    "perception.heuristic.cells.sliver_ratio": 1.5,
     "perception.heuristic.cells.min_seen": 0.55,
     "perception.heuristic.cells.min_tile_side": 0.25,
     "perception.heuristic.cells.min_tiles": 3,

@@ -338,7 +338,51 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
     out: list[Cell] = []
     for c in cells:
         out += _split_handles(c, vert, horiz, coverage, min_px, g, p, learned)
+    if cells_cfg.sliver_max > 0:
+        out = merge_slivers(out, int(cells_cfg.sliver_max / o.res), cells_cfg.sliver_ratio)
     return out
+
+
+def _part_handle(h: Handle, keep: np.ndarray) -> Handle | None:
+    """The pixels of ``h`` that ``keep`` selects, as a handle of their own (None: none)."""
+    px = h.pixels[keep]
+    if not len(px):
+        return None
+    box = (int(px[:, 0].min()), int(px[:, 1].min()), int(px[:, 0].max()) + 1, int(px[:, 1].max()) + 1)
+    return Handle(box, h.horizontal, px, h.knob)
+
+
+def merge_slivers(cells: list[Cell], max_px: int, ratio: float) -> list[Cell]:
+    """Cut each sliver (a cell at most ``max_px`` wide between two cells of its rows, each at least ``ratio``
+    times wider) down its middle and give each half, with its part of the sliver's handles, to its
+    neighbour. Where two doors meet, bar handles either side of the seam fuse into one blob, and no cut runs
+    through a handle, so the guillotine cut on both of its sides and left the stile between them as a cell;
+    the stile's middle is the seam (a dark line there is no help: the bars are dark lines too)."""
+    out = list(cells)
+    gone: set[int] = set()
+    for s in sorted(cells, key=lambda c: c.c1 - c.c0):
+        w = s.c1 - s.c0
+        if w > max_px or id(s) in gone:
+            continue
+
+        def beside(c: Cell) -> bool:
+            return (c is not s and id(c) not in gone and abs(c.r0 - s.r0) <= 2 and abs(c.r1 - s.r1) <= 2
+                    and c.c1 - c.c0 >= ratio * w)
+
+        left = [c for c in out if beside(c) and abs(c.c1 + 1 - s.c0) <= 1]
+        right = [c for c in out if beside(c) and abs(s.c1 + 1 - c.c0) <= 1]
+        if len(left) != 1 or len(right) != 1:
+            continue
+        a, b = left[0], right[0]
+        cut = (s.c0 + s.c1) // 2
+        for h in s.handles:
+            for side, keep in ((a, h.pixels[:, 0] < cut), (b, h.pixels[:, 0] > cut)):
+                part = _part_handle(h, keep)
+                if part is not None:
+                    side.handles.append(part)
+        a.c1, b.c0 = cut, cut + 1
+        gone.add(id(s))
+    return [c for c in out if id(c) not in gone]
 
 
 def _profile(ev: np.ndarray, cov: np.ndarray, axis: int, chunks: int = 1) -> np.ndarray:
@@ -636,6 +680,11 @@ def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int,
     return lo + int(np.argmax(prof)) if prof.max() > p.between_span else (lo + hi) // 2
 
 
+def _nested(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
+    """Whether the columns of one pixel box lie within those of the other."""
+    return (a[0] <= b[0] and b[2] <= a[2]) or (b[0] <= a[0] and a[2] <= b[2])
+
+
 def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: np.ndarray,
                    p: SeamConfig, learned: LearnedLines | None = None) -> list[Cell]:
     """Split a cell between consecutive handles (side by side: at the best column between them;
@@ -651,6 +700,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
     if span_x >= span_y:
         gaps = np.diff(xs)
         k = int(np.argmax(gaps))
+        if _nested(hs[k].box, hs[k + 1].box):
+            return [c]  # one lies across the other's columns (a bar over a frame rail): not side by side
         lo, hi = int(hs[k].box[2]), int(hs[k + 1].box[0])
         if hi - lo < 2:
             lo, hi = int(xs[k]), int(xs[k + 1])
