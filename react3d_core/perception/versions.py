@@ -64,6 +64,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 34: handles.hidden_side off by default (it cost RedKitchen three fronts)
 # 35: a sliver cell between two wider cells of its rows is the stile where two doors meet: cut down its
 #     middle into its neighbours, with its handle halves (cells.sliver_max)
-HEURISTIC_VERSION = "35"
+# 36: fronts seen through a glass door (behind another plane's pane, within a cabinet's depth) are the
+#     cabinet's inside, not fronts (image.glass_behind)
+HEURISTIC_VERSION = "36"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

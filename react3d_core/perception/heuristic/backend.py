@@ -21,6 +21,7 @@ from ...data.mesh import TriMesh, load_mesh
 from ...errors import ConfigError
 from ...raster import Rasterizer
 from ...scene_io.images import frame_rgb
+from .behind_glass import seen_through_glass
 from .facets import planar_facets
 from .constants import COLOUR_NDIM, RGB
 from .fronts import Front, find_fronts
@@ -84,6 +85,10 @@ class HeuristicModel:
             self.image = find_image_fronts(self.mesh, scene.frames, self.raster, frame_rgb, h, taken, self.fronts,
                                            line_detector)
             self.fronts = [f for k, f in enumerate(self.fronts) if k not in set(self.image.vetoed)] + self.image.fronts
+            if h.image.glass_behind > 0 and self.image.panes:  # a glass cabinet's inside, seen through its doors
+                inside = seen_through_glass(self.fronts, self.image.panes, h.image.glass_behind_min, h.image.glass_behind,
+                                            h.image.glass_behind_share)
+                self.fronts = [f for f, drop in zip(self.fronts, inside) if not drop]
         chest_lids(self.fronts, self.mesh, h.lids, rules.flap_max_deg)  # a chest's lip with a bar: its lid
         if h.splashback.enabled:  # fronts flush with the wall right above a worktop are splash-back
             self.fronts = [f for f, drop in zip(self.fronts, on_worktop(self.fronts, self.mesh, h.splashback)) if not drop]

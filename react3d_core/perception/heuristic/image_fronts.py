@@ -24,6 +24,7 @@ from ...data.frames import Frame
 from ...data.mesh import TriMesh
 from ...geometry import weighted_median
 from ...raster import Rasterizer
+from .behind_glass import PaneRegion
 from .front_cells import Cell, Handle, find_handles, off_background, off_local, off_threshold, split_cells
 from .fronts import Front, _joint, _neighbours, doors_in_rows, u_overlap
 from .line_evidence import LineSupport, line_support
@@ -52,6 +53,7 @@ class ImageFronts:
     calibration: ColourCalibration
     registration: dict[int, ColourCalibration] = field(default_factory=dict)  # per-view correction by frame index
     lines: list[LineSupport] = field(default_factory=list)  # learned line support per plane (empty: not used)
+    panes: list[PaneRegion] = field(default_factory=list)  # planes' glass panes, grown by their frames
 
 
 def floor_height(mesh: TriMesh, cfg: FloorConfig) -> float | None:
@@ -486,6 +488,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     round_doors: set[int] = set()  # porthole doors (``portholes``): kept, and hinged at a side
     one_cut = cfg.cells.single_cut or cfg.cells.piece_max_w > 0
     veto_evidence: list[VetoEvidence] = []
+    pane_regions: list[PaneRegion] = []
     for i, o in enumerate(orthos):
         # a modelled scene's fronts are a few large triangles cut apart by exact seams: the mesh rules read
         # those, and rays reading the whole of them cut panels and bevels into false cells
@@ -514,6 +517,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                              cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
                              cfg.image.pane_min_fill)
         if panes.any():
+            pane_regions.append(PaneRegion.of(o, panes, cfg.image.glass_behind_grow))
             cov = cov | panes
             if cfg.image.pane_cell_cover:  # a glass door's cell is its frame and its pane, not the ring alone
                 cell_cov = cell_cov | panes
@@ -590,7 +594,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         f.kind, f.articulation = _joint(f, hpts, _neighbours(f, fronts, rules), rules, side_hinged=id(f) in round_doors)
     doors_in_rows(fronts, rules)
     vetoed = sorted(split_mesh | {k for k, f in enumerate(mesh_fronts) if _cluttered(f, orthos, veto_evidence, cfg)})
-    return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports)
+    return ImageFronts(fronts, vetoed, planes, orthos, calib, per_view, supports, pane_regions)
 
 
 def plain_fronts_kept(fronts: list[Front], rules: FrontRulesConfig, gridded: set[int], stacked: set[int],
