@@ -66,6 +66,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     middle into its neighbours, with its handle halves (cells.sliver_max)
 # 36: fronts seen through a glass door (behind another plane's pane, within a cabinet's depth) are the
 #     cabinet's inside, not fronts (image.glass_behind)
-HEURISTIC_VERSION = "36"
+# 37: image.pane_seen_rim on (0.035): a TSDF glass door's top rail on the fused box's rounded edge frames its pane
+HEURISTIC_VERSION = "37"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"
