@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # One command: install what is missing (system libraries and headless Chromium included), then run the
-# fast test suite and print its 15 slowest steps. An apt package that could not be installed is not
+# fast test suite and the whole-process runs (-m integration), each printing its 10 slowest steps. An apt package that could not be installed is not
 # tried again on every run: remove .tools/apt-unavailable-<name> to retry.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,4 +18,6 @@ command -v chromium >/dev/null || apt_once chromium "browser tests will be skipp
 command -v docker-compose >/dev/null || docker compose version >/dev/null 2>&1 \
   || apt_once docker-compose "compose validation skipped (it validates docker-compose.yml; no engine needed)"
 export TMPDIR="${TMPDIR:-/tmp}"
-python3 -m pytest -n 2 --dist loadfile --durations=15 -q "$@"
+# the fast suite, then the whole-process runs (CLI subprocesses, Prefect servers); both must pass
+python3 -m pytest -n 2 --dist loadfile --durations=10 -q "$@"
+python3 -m pytest -n 2 --dist loadfile --durations=10 -q -m integration "$@"

@@ -21,7 +21,7 @@ import pytest
 
 from deployments.local_cluster import ROOT, S3Server, s3rver_command
 
-pytestmark = pytest.mark.skipif(s3rver_command() is None, reason="s3rver not installed (bash scripts/setup.sh test)")
+pytestmark = [pytest.mark.integration, pytest.mark.skipif(s3rver_command() is None, reason="s3rver not installed (bash scripts/setup.sh test)")]
 
 
 @pytest.fixture()

@@ -11,6 +11,8 @@ from flows.bench.runner import SETS_DIR, load_spec, print_table, run_bench, run_
 from react3d_core.data.mesh import TriMesh, load_mesh, save_mesh
 from react3d_core.errors import InputError
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 
 def test_set_files_are_valid(tmp_path):
     heldout = load_spec("heldout", tmp_path)

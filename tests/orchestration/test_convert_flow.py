@@ -18,6 +18,8 @@ from flows.convert_scene import convert_scene
 from react3d_core.data.parts import InteractiveScene
 from tasks.retry import TransientError
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 CFG = {"perception": {"backend": "oracle"}, "frames": {"stride": 1},
        "export": {"formats": ["urdf", "mjcf"]}}
 

@@ -12,6 +12,8 @@ from typing import Any
 
 import pytest
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 ROOT = Path(__file__).resolve().parents[2]
 
 

@@ -19,6 +19,8 @@ import pytest
 
 from .conftest import convert_oracle_urdf as convert, copy_first_run
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 
 def _flip(path: Path, at: float = 0.5) -> None:
     data = bytearray(path.read_bytes())

@@ -12,6 +12,8 @@ import pytest
 
 from .conftest import FAST, first_line, run_cli, run_cli_here, snapshot
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 
 @pytest.mark.parametrize("extra, words", [
     (["--config", "LIST"], "must be a JSON object"),

@@ -10,6 +10,8 @@ import pytest
 
 from .conftest import FAST, first_line, run_cli, run_cli_here, snapshot
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 
 def _refused(r, command: str, path: Path, words: str) -> None:  # noqa: ANN001
     assert r.returncode == 2, (r.returncode, r.stderr[-2000:])

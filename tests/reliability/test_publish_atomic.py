@@ -18,6 +18,8 @@ from react3d_core.atomic import OUTPUT_MARKER, _HOST, atomic_dir, clean_leftover
 
 from .conftest import FAST, REPO, end_group, run_cli, snapshot
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 
 def _dead_pid() -> int:
     p = subprocess.Popen([sys.executable, "-c", "pass"])

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 ROOT = Path(__file__).resolve().parents[2]
 pytest.importorskip("transformers")
 

@@ -19,6 +19,8 @@ import pytest
 
 from .conftest import convert_oracle_urdf as convert, copy_first_run
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 
 class _Touch:
     """Unpickling this object creates ``path`` (a stand-in for any code an attacker would run)."""

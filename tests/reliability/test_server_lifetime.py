@@ -12,6 +12,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 from flows import local_server
 
 from .conftest import FAST, REPO, end_group, isolated_env, run_cli
@@ -103,6 +105,8 @@ PYTHON_RUN = """
 import sys
 from prefect import flow
 import flows.convert_scene  # routes Prefect's temporary server through flows.server_watchdog
+
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
 
 @flow
 def nothing() -> None:

@@ -15,10 +15,14 @@ import time
 import urllib.request
 from pathlib import Path
 
+import pytest
+
 from flows import local_server
 from tasks.prefect_env import server_reachable
 
 from .conftest import FAST, REPO, end_group, first_line, isolated_env, run_cli, run_cli_here
+
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
 
 NOTE = "started a local Prefect server"
 
