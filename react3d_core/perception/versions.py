@@ -67,6 +67,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 36: fronts seen through a glass door (behind another plane's pane, within a cabinet's depth) are the
 #     cabinet's inside, not fronts (image.glass_behind)
 # 37: image.pane_seen_rim on (0.035): a TSDF glass door's top rail on the fused box's rounded edge frames its pane
-HEURISTIC_VERSION = "37"
+# 38: knobs are handles by default, kept in patterns (pairs in a row or column; not a control panel's row);
+#     two knobs side by side are cut apart only at a seam; a knob-only cell is cut with a knob on one side
+HEURISTIC_VERSION = "38"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

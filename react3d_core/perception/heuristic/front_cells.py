@@ -211,9 +211,50 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
                 continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
+    if p.knob_pair > 0:
+        out = knobs_in_patterns(out, p.knob_pair / o.res, p.knob_pair_size, p.knob_pair_reach / o.res,
+                                p.knob_panel_gap / o.res)
     if protrusion is not None and not bars_only:
         out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share, p.bar_reach / o.res)
     return out
+
+
+_PANEL_KNOBS = 3  # a door pair has two knobs side by side; a control panel's row has more
+
+
+def knobs_in_patterns(handles: list[Handle], tol_px: float, size_ratio: float, reach_px: float = np.inf,
+                      panel_px: float = 0.0) -> list[Handle]:
+    """``handles`` less the knobs that no other knob of a like size (sides within ``size_ratio`` of each
+    other's) lines up with: centres within ``tol_px`` in the row or in the column, at most ``reach_px``
+    apart. Knobs in a row of three or more whose neighbours are at most ``panel_px`` apart go too.
+
+    Why: furniture repeats its knobs (a column of drawers, the two doors of a pair, a row of sideboard
+    fronts), while a compact blob on a real front (a reflection, a sticker, a screw head the scan caught)
+    passes the knob's size and fill tests alone: on RedKitchen every such blob stood alone on its plane
+    or off the others' rows and columns. A row of knobs closer than any front is wide is an appliance's
+    control panel: its knobs open nothing, and cutting between them halved the oven door below."""
+    knobs = [h for h in handles if h.knob]
+    if not knobs:
+        return handles
+    box = np.array([h.box for h in knobs], float)
+    cx, cy = (box[:, 0] + box[:, 2]) / 2, (box[:, 1] + box[:, 3]) / 2
+    w, h = box[:, 2] - box[:, 0], box[:, 3] - box[:, 1]
+    like = (np.maximum(w[:, None], w[None]) <= size_ratio * np.minimum(w[:, None], w[None])) & \
+        (np.maximum(h[:, None], h[None]) <= size_ratio * np.minimum(h[:, None], h[None]))
+    dx, dy = np.abs(cx[:, None] - cx[None]), np.abs(cy[:, None] - cy[None])
+    in_row = like & (dy <= tol_px)
+    panel = np.zeros(len(knobs), bool)
+    if panel_px > 0:
+        for i in range(len(knobs)):
+            row = np.flatnonzero(in_row[i])  # i and its like knobs in its row, left to right
+            xs = cx[row]
+            order = np.argsort(xs)
+            runs = np.split(row[order], np.flatnonzero(np.diff(xs[order]) > panel_px) + 1)
+            panel[i] = any(i in r and len(r) >= _PANEL_KNOBS for r in runs)
+    pair = like & ((dx <= tol_px) | (dy <= tol_px)) & (np.hypot(dx, dy) <= reach_px) & ~panel[:, None] & ~panel[None]
+    np.fill_diagonal(pair, False)
+    kept = {id(k) for k, ok in zip(knobs, pair.any(1)) if ok}
+    return [h for h in handles if not h.knob or id(h) in kept]
 
 
 def _at_hidden_edge(hidden: np.ndarray, protrusion: np.ndarray | None, mine: np.ndarray,
@@ -615,7 +656,7 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
         sc_v = sc_v if sc_v >= p.prominence else 0.0
         sc_h = sc_h if sc_h >= p.prominence_h else 0.0
     mine = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
-    if sc_h and mine:
+    if sc_h and mine and not (q.knobs_any_side and all(h.knob for h in mine)):
         cut = c.r0 + ch_
         above, below = any(h.center[1] < cut for h in mine), any(h.center[1] > cut for h in mine)
         if not (above and below):
@@ -657,16 +698,17 @@ def _edge_strip(c: Cell, cut: int, above: bool, strip_px: int, handles: list[Han
 
 
 def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: SeamConfig,
-             learned: np.ndarray | None = None, span: float = 1.0, centres: tuple[int, int] | None = None) -> int:
+             learned: np.ndarray | None = None, span: float = 1.0, centres: tuple[int, int] | None = None,
+             seam_only: bool = False) -> int:
     """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the line ``learned`` line
     evidence covers most, when it covers at least ``span`` of the cell; else the strongest straight seam
     (``_dip_scores`` >= ``between_z`` noise units), sought between the handles' ``centres`` when given
     (a handle's box, grown by the bar closing and blurred by misregistration, reaches a few px over the
     seam beside it: a drawer's seam just above the handle of the door below was outside [lo, hi) and the
     cut fell halfway up the drawer); else the most seam-like line by valley counts (covering more than
-    ``between_span``), else the middle."""
+    ``between_span``), else the middle (``seam_only``: -1, no line)."""
     if hi - lo < 1:
-        return (lo + hi) // 2
+        return -1 if seam_only else (lo + hi) // 2
     if learned is not None:
         prof = _profile(learned, cov, axis)[lo:hi]
         if prof.max() >= span:
@@ -677,7 +719,9 @@ def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int,
         return a + int(np.argmax(z))
     sl = (slice(None), slice(lo, hi)) if axis == 0 else (slice(lo, hi), slice(None))
     prof = _profile(ev[sl], cov[sl], axis)
-    return lo + int(np.argmax(prof)) if prof.max() > p.between_span else (lo + hi) // 2
+    if prof.max() > p.between_span:
+        return lo + int(np.argmax(prof))
+    return -1 if seam_only else (lo + hi) // 2
 
 
 def _nested(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
@@ -706,9 +750,12 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         if hi - lo < 2:
             lo, hi = int(xs[k]), int(xs[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
+        knobs = p.knob_seam and hs[k].knob and hs[k + 1].knob
         cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
                               None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
-                              (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0))
+                              (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0), seam_only=knobs)
+        if cut < c.c0:
+            return [c]  # two knobs side by side with no seam between them: one wide drawer's or a panel's
         a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):

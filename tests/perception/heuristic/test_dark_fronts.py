@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from react3d_core.config.heuristic import FrontRulesConfig, HeuristicConfig
-from react3d_core.perception.heuristic.front_cells import _is_knob, find_handles, split_cells
+from react3d_core.perception.heuristic.front_cells import Handle, _is_knob, find_handles, knobs_in_patterns, split_cells
 from react3d_core.perception.heuristic.fronts import Front, _joint
 from tests.perception.heuristic.flat_orthos import flat_ortho
 
@@ -147,3 +147,110 @@ def test_bench_dark_fronts_box_and_f1_by_hand() -> None:
     assert f1(3, 4, 5) == pytest.approx(6 / 9)
     assert f1(0, 0, 0) == 0.0
 
+
+
+def test_knobs_are_kept_in_patterns_and_a_lone_blob_is_not() -> None:
+    """The three drawer knobs of the column above line up (centres in column 55, 5 cm discs): with
+    ``knob_pair`` 2 cm each has a like knob in its column, so all three stay. A lone 5 cm pale disc on a
+    0.44 x 0.3 m front (a blob on a real front passing the knob tests) has no other knob on its plane and
+    goes; so does a second disc 8 cm off its row and column (40 px right, 20 px down), and a disc that lines
+    up with it but is much smaller (a 2.8 cm square beside the 5.2 cm disc: 13 / 7 px > 1.4)."""
+    rng = np.random.default_rng(7)
+    on = HeuristicConfig(handles={"knobs": True, "knob_pair": 0.02})
+    img = np.full((188, 110, 3), 0.15, np.float32) + rng.normal(0, 0.003, (188, 110, 3)).astype(np.float32)
+    for r in (31, 94, 157):
+        _disc(img, r, 55, 6, 0.9)
+    o, cov = _ortho(img), np.ones(img.shape[:2], bool)
+    assert len(find_handles(o, cov, on)) == 3
+    assert len(find_handles(o, cov, on.model_copy(update={"handles": on.handles.model_copy(update={"knob_pair": 0.0})}))) == 3
+
+    lone = np.full((75, 110, 3), 0.15, np.float32) + rng.normal(0, 0.003, (75, 110, 3)).astype(np.float32)
+    _disc(lone, 30, 40, 6, 0.9)
+    o, cov = _ortho(lone), np.ones(lone.shape[:2], bool)
+    assert len(find_handles(o, cov, HeuristicConfig(handles={"knobs": True, "knob_pair": 0.0}))) == 1
+    assert find_handles(o, cov, on) == []
+    _disc(lone, 50, 80, 6, 0.9)  # off its row (20 px) and column (40 px)
+    o = _ortho(lone)
+    assert len(find_handles(o, cov, HeuristicConfig(handles={"knobs": True, "knob_pair": 0.0}))) == 2
+    assert find_handles(o, cov, on) == []
+    small = np.full((75, 110, 3), 0.15, np.float32) + rng.normal(0, 0.003, (75, 110, 3)).astype(np.float32)
+    _disc(small, 30, 40, 6, 0.9)
+    small[27:34, 77:84] = 0.9  # a square knob in its row, 2.8 cm across
+    o = _ortho(small)
+    found = find_handles(o, cov, HeuristicConfig(handles={"knobs": True, "knob_pair": 0.0}))
+    assert len(found) == 2 and all(k.knob for k in found)
+    assert find_handles(o, cov, on) == []
+
+
+def test_two_knobs_side_by_side_are_cut_apart_only_at_a_seam() -> None:
+    """A 0.6 x 0.2 m drawer (150 x 50 px) with two 5 cm knobs at a quarter and three quarters of its width
+    (columns 37 and 112) and no seam: split between its handles it was halved at the middle (column 75).
+    With ``seams.knob_seam`` it stays one cell. Two 0.3 m drawers side by side, the same knobs, with a 2 px
+    dark seam at column 75 (0.05 under the fronts' 0.6), are cut there either way."""
+    rng = np.random.default_rng(3)
+
+    def cells(seam: bool, knob_seam: bool) -> list:
+        img = np.full((50, 150, 3), 0.6, np.float32) + rng.normal(0, 0.003, (50, 150, 3)).astype(np.float32)
+        if seam:
+            img[:, 74:76] = 0.55
+        for c in (37, 112):
+            _disc(img, 25, c, 6, 0.1)
+        o, cov = _ortho(img), np.ones(img.shape[:2], bool)
+        cfg = HeuristicConfig(handles={"knobs": True}, seams={"knob_seam": knob_seam})
+        hs = find_handles(o, cov, cfg)
+        assert len(hs) == 2 and all(h.knob for h in hs)
+        return split_cells(o, cov, hs, cfg)
+
+    assert len(cells(False, False)) == 2
+    assert len(cells(False, True)) == 1
+    for knob_seam in (False, True):
+        got = cells(True, knob_seam)
+        assert len(got) == 2 and 72 <= min(c.c1 for c in got) <= 77
+
+
+def _knob(c: int, r: int, side: int = 11) -> Handle:
+    """A knob handle ``side`` px square centred near (c, r)."""
+    box = (c - side // 2, r - side // 2, c - side // 2 + side, r - side // 2 + side)
+    return Handle(box, True, np.array([[c, r]]), True)
+
+
+def test_a_row_of_close_knobs_is_a_control_panel_and_far_rows_are_no_pair() -> None:
+    """At 4 mm (tolerance 2 cm = 5 px, reach 1 m = 250 px, panel gap 16 cm = 40 px), 11 px knobs:
+    - four in a row 32 px (13 cm) apart (an oven's control panel, the trace of tuning scene 310) all go;
+      three of them 50 px (20 cm) apart are fronts' knobs in a row, and stay;
+    - two in a row 300 px (1.2 m) apart (blobs along the floor line) go; 200 px (0.8 m) apart they stay;
+    - a door pair's two knobs 24 px (10 cm) apart stay (two are no panel)."""
+    def kept(hs: list[Handle]) -> int:
+        return len(knobs_in_patterns(hs, 5, 1.4, 250, 40))
+
+    assert kept([_knob(100 + 32 * i, 50) for i in range(4)]) == 0
+    assert kept([_knob(100 + 50 * i, 50) for i in range(3)]) == 3
+    assert kept([_knob(100 + 32 * i, 50) for i in range(4)] + [_knob(600, 300)]) == 0
+    assert kept([_knob(100, 300), _knob(400, 300)]) == 0
+    assert kept([_knob(100, 300), _knob(300, 300)]) == 2
+    assert kept([_knob(100, 50), _knob(124, 50)]) == 2
+    assert len(knobs_in_patterns([_knob(100 + 32 * i, 50) for i in range(4)], 5, 1.4, 250, 0.0)) == 4
+
+
+def test_a_knob_only_cell_is_cut_at_a_seam_with_a_knob_on_one_side() -> None:
+    """A 0.44 x 0.66 m column (110 x 165 px) of three drawers 55 px tall, 2 px dark seams at rows 54 and
+    109; the lower two carry a 5 cm knob each (rows 82 and 137, a pair in one column), the top one none (its
+    single knob stood alone and was not taken). A horizontal cut must leave a handle on both sides, so the
+    seam under the top drawer was refused and the top drawer merged with the middle one (2 cells). With
+    ``cells.knobs_any_side`` a cell holding only knobs is cut there: 3 cells, cut at the seams."""
+    rng = np.random.default_rng(5)
+    img = np.full((165, 110, 3), 0.6, np.float32) + rng.normal(0, 0.003, (165, 110, 3)).astype(np.float32)
+    img[54:56] = 0.45
+    img[109:111] = 0.45
+    for r in (82, 137):
+        _disc(img, r, 55, 6, 0.1)
+    o, cov = _ortho(img), np.ones(img.shape[:2], bool)
+    got = {}
+    for on in (False, True):
+        cfg = HeuristicConfig(cells={"knobs_any_side": on})
+        hs = find_handles(o, cov, cfg)
+        assert len(hs) == 2 and all(h.knob for h in hs)
+        got[on] = sorted((c.r0, c.r1) for c in split_cells(o, cov, hs, cfg))
+    assert len(got[False]) == 2
+    assert len(got[True]) == 3
+    assert 52 <= got[True][0][1] <= 57 and 107 <= got[True][1][1] <= 112
