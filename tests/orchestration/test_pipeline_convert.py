@@ -12,14 +12,14 @@ import pytest
 from flows.convert_scene import convert_scene
 from react3d_core.data.parts import InteractiveScene
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 ROOT = Path(__file__).resolve().parents[2]
 CFG = {"frames": {"stride": 1}, "perception": {"backend": "oracle"}, "export": {"formats": ["urdf"]}}
 
 PIPELINE = """
 import json, sys
 from react3d_core.pipeline import convert
-
-pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
 seen = []
 m = convert(sys.argv[1], sys.argv[2], json.loads(sys.argv[3]), progress=lambda s, d, n: seen.append(s))
 print(json.dumps({"prefect": "prefect" in sys.modules, "torch": "torch" in sys.modules, "n": len(m.objects),

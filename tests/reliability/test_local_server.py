@@ -18,6 +18,8 @@ from flows import local_server
 
 from .conftest import REPO, isolated_env
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 HOLD = """
 import fcntl, os, sys, time
 fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT)
@@ -45,8 +47,6 @@ def test_a_lease_ends_with_its_holder_even_after_kill_9(tmp_path: Path) -> None:
 CONNECT = """
 import json, sys
 from flows import local_server
-
-pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
 s = local_server.connect(sys.argv[1])
 s.wait_ready()
 print(json.dumps({"url": s.url, "pid": s.pid, "started": s.started}), flush=True)

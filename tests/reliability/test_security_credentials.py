@@ -15,6 +15,8 @@ from pathlib import Path
 
 import pytest
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 ROOT = Path(__file__).resolve().parents[2]
 SECRET = "sk-test-7f3a9c1e"
 
@@ -109,8 +111,6 @@ SECRET_BLOCK = """
 import os, sys
 from prefect.blocks.system import Secret
 from react3d_models.runtime import api_key
-
-pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
 Secret(value=sys.argv[1]).save("react3d-opdmulti-key")
 os.environ["REACT3D_OPDMULTI_API_KEY_BLOCK"] = "react3d-opdmulti-key"
 print("KEY", api_key(("REACT3D_OPDMULTI_API_KEY",), "REACT3D_OPDMULTI_API_KEY_BLOCK") == sys.argv[1])

@@ -18,6 +18,8 @@ from flows import local_server
 
 from .conftest import FAST, REPO, end_group, isolated_env, run_cli
 
+pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
+
 IDLE_S = 3
 
 
@@ -105,8 +107,6 @@ PYTHON_RUN = """
 import sys
 from prefect import flow
 import flows.convert_scene  # routes Prefect's temporary server through flows.server_watchdog
-
-pytestmark = pytest.mark.integration  # whole-process runs (CLI subprocesses, Prefect servers)
 
 @flow
 def nothing() -> None:
