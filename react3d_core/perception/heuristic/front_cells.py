@@ -699,16 +699,16 @@ def _edge_strip(c: Cell, cut: int, above: bool, strip_px: int, handles: list[Han
 
 def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int, hi: int, min_px: int, p: SeamConfig,
              learned: np.ndarray | None = None, span: float = 1.0, centres: tuple[int, int] | None = None,
-             seam_only: bool = False) -> int:
+             seam_only: bool = False) -> int | None:
     """The line in [lo, hi) of a cell's pixels where two handled fronts meet: the line ``learned`` line
     evidence covers most, when it covers at least ``span`` of the cell; else the strongest straight seam
     (``_dip_scores`` >= ``between_z`` noise units), sought between the handles' ``centres`` when given
     (a handle's box, grown by the bar closing and blurred by misregistration, reaches a few px over the
     seam beside it: a drawer's seam just above the handle of the door below was outside [lo, hi) and the
     cut fell halfway up the drawer); else the most seam-like line by valley counts (covering more than
-    ``between_span``), else the middle (``seam_only``: -1, no line)."""
+    ``between_span``), else the middle (``seam_only``: None, no line)."""
     if hi - lo < 1:
-        return -1 if seam_only else (lo + hi) // 2
+        return None if seam_only else (lo + hi) // 2
     if learned is not None:
         prof = _profile(learned, cov, axis)[lo:hi]
         if prof.max() >= span:
@@ -721,7 +721,7 @@ def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int,
     prof = _profile(ev[sl], cov[sl], axis)
     if prof.max() > p.between_span:
         return lo + int(np.argmax(prof))
-    return -1 if seam_only else (lo + hi) // 2
+    return None if seam_only else (lo + hi) // 2
 
 
 def _nested(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
@@ -751,11 +751,12 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
             lo, hi = int(xs[k]), int(xs[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
         knobs = p.knob_seam and hs[k].knob and hs[k + 1].knob
-        cut = c.c0 + _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
-                              None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
-                              (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0), seam_only=knobs)
-        if cut < c.c0:
+        at = _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
+                      None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
+                      (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0), seam_only=knobs)
+        if at is None:
             return [c]  # two knobs side by side with no seam between them: one wide drawer's or a panel's
+        cut = c.c0 + at
         a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
         if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):
