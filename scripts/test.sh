@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # One command: install what is missing (system libraries and headless Chromium included), then run the
-# fast test suite and the whole-process runs (-m integration), each printing its 10 slowest steps. An apt package that could not be installed is not
-# tried again on every run: remove .tools/apt-unavailable-<name> to retry.
+# fast test suite and the whole-process runs (-m integration), each printing its 10 slowest steps. An apt
+# package that could not be installed is not tried again on every run: remove
+# .tools/apt-unavailable-<name> to retry.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh test
@@ -18,9 +19,12 @@ command -v chromium >/dev/null || apt_once chromium "browser tests will be skipp
 command -v docker-compose >/dev/null || docker compose version >/dev/null 2>&1 \
   || apt_once docker-compose "compose validation skipped (it validates docker-compose.yml; no engine needed)"
 export TMPDIR="${TMPDIR:-/tmp}"
-# the fast suite, then the whole-process runs (CLI subprocesses, Prefect servers); both must pass
-# (exit status 5: the paths given hold no test of that group)
-for group in "not slow and not gpu and not integration" "integration"; do
-  rc=0; python3 -m pytest -n 2 --dist loadfile --durations=10 -q -m "$group" "$@" || rc=$?
+# the fast suite (pyproject's default marker expression), then the whole-process runs (CLI subprocesses,
+# Prefect servers); both must pass. Exit status 5: the paths given hold no test of that group.
+group() {
+  local rc=0
+  python3 -m pytest -n 2 --dist loadfile --durations=10 -q "$@" || rc=$?
   [ "$rc" = 0 ] || [ "$rc" = 5 ] || exit "$rc"
-done
+}
+group "$@"
+group -m integration "$@"
