@@ -69,6 +69,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 37: image.pane_seen_rim on (0.035): a TSDF glass door's top rail on the fused box's rounded edge frames its pane
 # 38: knobs are handles by default, kept in patterns (pairs in a row or column; not a control panel's row);
 #     two knobs side by side are cut apart only at a seam; a knob-only cell is cut with a knob on one side
-HEURISTIC_VERSION = "38"
+# 39: no cut runs through a knob that stands alone (cells.lone_knobs_block)
+HEURISTIC_VERSION = "39"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -153,9 +153,10 @@ def off_threshold(diff: np.ndarray, valid: np.ndarray, cfg: HeuristicConfig) -> 
 
 def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff: np.ndarray | None = None,
                  protrusion: np.ndarray | None = None, outline: np.ndarray | None = None,
-                 bars_only: bool = False) -> list[Handle]:
+                 bars_only: bool = False, lone: list[Handle] | None = None) -> list[Handle]:
     """Compact elongated blobs whose colour differs from the local background (see module docstring),
-    and with ``handles.knobs`` compact round ones (``_is_knob``) unless ``bars_only``.
+    and with ``handles.knobs`` compact round ones (``_is_knob``) unless ``bars_only``; the knobs left out
+    for standing alone (``knobs_in_patterns``) are appended to ``lone`` when given.
     Colour blobs keep ``handles.outline_margin`` inside ``coverage`` (colour beside a scanning shadow is
     misregistered); a handle must lie inside ``outline`` (coverage with handle shadows filled; default
     ``coverage``)."""
@@ -212,8 +213,12 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
     if p.knob_pair > 0:
-        out = knobs_in_patterns(out, p.knob_pair / o.res, p.knob_pair_size, p.knob_pair_reach / o.res,
-                                p.knob_panel_gap / o.res)
+        kept = knobs_in_patterns(out, p.knob_pair / o.res, p.knob_pair_size, p.knob_pair_reach / o.res,
+                                 p.knob_panel_gap / o.res)
+        if lone is not None:
+            ids = {id(h) for h in kept}
+            lone += [h for h in out if id(h) not in ids]
+        out = kept
     if protrusion is not None and not bars_only:
         out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share, p.bar_reach / o.res)
     return out
@@ -339,10 +344,13 @@ def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int) -> tu
 
 
 def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg: HeuristicConfig,
-                lines: tuple[np.ndarray, np.ndarray] | None = None) -> list[Cell]:
+                lines: tuple[np.ndarray, np.ndarray] | None = None, lone: list[Handle] = ()) -> list[Cell]:
     """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs.
     ``lines``: pixels on vertical and on horizontal lines that learned line segments of several views
-    support (line_evidence.py; ``perception.heuristic.lines``), a seam where the brightness shows none."""
+    support (line_evidence.py; ``perception.heuristic.lines``), a seam where the brightness shows none.
+    ``lone``: knobs not taken as handles; with ``cells.lone_knobs_block`` no cut runs through them either
+    (a chest's wide top drawer has one knob in its middle, over the seam between the two drawers of each
+    row below; the seam's line ran on up through the knob and halved the top drawer)."""
     rows, cols = np.nonzero(coverage)
     if not len(rows):
         return []
@@ -352,7 +360,7 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
     min_px = max(2, int(cells_cfg.min_side / o.res))
     blocked_c = np.zeros(coverage.shape[1], bool)  # no cut runs through a handle
     blocked_r = np.zeros(coverage.shape[0], bool)
-    for h in handles:
+    for h in list(handles) + (list(lone) if cells_cfg.lone_knobs_block else []):
         blocked_c[h.box[0]:h.box[2]] = True
         blocked_r[h.box[1]:h.box[3]] = True
     col = np.where((o.n_views > 0)[..., None], o.color, np.nan)  # unseen pixels carry no colour

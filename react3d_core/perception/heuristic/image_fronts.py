@@ -528,7 +528,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         win = hc.background_win if hc.protrusion_from_surface else 0.0
         bars = (protrusion_map(o, surf, hc, win, cfg.planes.offset_tol) if rays
                 else protrusion_from_faces(o, centroids, mesh.face_normals, hc, win, cfg.planes.offset_tol))
-        handles = find_handles(o, cov, cfg, diff, bars & outline, outline)
+        lone: list[Handle] = []
+        handles = find_handles(o, cov, cfg, diff, bars & outline, outline, lone=lone)
         thr = off_threshold(diff, o.n_views > 0, cfg)
         veto_evidence.append(VetoEvidence(thr, _hardware(bars, handles)))
         shadows: list[Handle] = []
@@ -544,7 +545,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         p = o.plane
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
-        cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None)
+        cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None, lone)
         tiled = is_tiled(cells, cov, o.res, cfg.cells)
         mine: list[Front] = []
         for cell in cells:

@@ -254,3 +254,30 @@ def test_a_knob_only_cell_is_cut_at_a_seam_with_a_knob_on_one_side() -> None:
     assert len(got[False]) == 2
     assert len(got[True]) == 3
     assert 52 <= got[True][0][1] <= 57 and 107 <= got[True][1][1] <= 112
+
+
+def test_no_cut_runs_through_a_lone_knob() -> None:
+    """A 0.8 x 0.6 m chest (200 x 150 px at 4 mm): a wide top drawer (rows 0-48) with one 5 cm knob in its
+    middle (column 100), over two rows of two drawers each, 2 px seams at rows 49 and 99 and a darker one
+    down column 100 below the top drawer, a knob in the middle of each. The four lower knobs line up in
+    pairs and are handles; the top one stands alone and is not. The column seam's line runs on up through
+    it, so the top drawer was halved (6 cells); with ``cells.lone_knobs_block`` it stays whole (5 cells)."""
+    rng = np.random.default_rng(11)
+    img = np.full((150, 200, 3), 0.6, np.float32) + rng.normal(0, 0.003, (150, 200, 3)).astype(np.float32)
+    img[49:51] = 0.5
+    img[99:101] = 0.5
+    img[50:, 99:101] = 0.4
+    _disc(img, 25, 100, 6, 0.1)
+    for r in (75, 125):
+        for c in (50, 150):
+            _disc(img, r, c, 6, 0.1)
+    o, cov = _ortho(img), np.ones(img.shape[:2], bool)
+    got = {}
+    for on in (False, True):
+        cfg = HeuristicConfig(cells={"lone_knobs_block": on})
+        lone: list[Handle] = []
+        hs = find_handles(o, cov, cfg, lone=lone)
+        assert len(hs) == 4 and len(lone) == 1 and lone[0].knob
+        got[on] = sorted((c.r0, c.c0, c.r1, c.c1) for c in split_cells(o, cov, hs, cfg, None, lone))
+    assert len(got[False]) == 6 and [c for c in got[False] if c[0] == 0][0][3] <= 101
+    assert len(got[True]) == 5 and got[True][0][:2] == (0, 0) and got[True][0][3] == 200
