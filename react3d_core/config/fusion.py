@@ -22,6 +22,7 @@ class FusionConfig(StageConfig):
     max_anchors: int = Field(8, ge=1, description="Face graph: anchor faces sampled per mask (each lifted face is paired with them; enough to bridge gaps).")
     distinct_jaccard: float = Field(0.95, ge=0, le=1, description="A community found again at another resolution (face Jaccard above this) is merged into the first.")
     claimed_share: float = Field(0.8, ge=0, le=1, description="A proposal with more than this share of its faces in earlier candidates is not re-segmented (it would re-segment to them).")
+    lid_claims_skirt: bool = Field(True, description="A lid's re-segmented faces that its clip to the top's plane left out (the lip and the side skirts hanging from the top) are the lid's: no other candidate is made of them. Off, the skirts' own proposals became flaps of their own beside the lid (free-standing tuning chest freezers: one lid exported as two or three parts).")
     duplicate_iou: float = Field(0.5, ge=0, le=1, description="Candidates of several resolutions: a later one with vertex IoU above this with a kept one is dropped ...")
     duplicate_contained: float = Field(0.8, ge=0, le=1, description="... as is one with more than this share of its vertices inside a kept one (a piece of it).")
 

@@ -75,6 +75,11 @@ def lid_plane(cen: np.ndarray, nrm: np.ndarray, area: np.ndarray, camera: np.nda
     return np.array([0.0, 0.0, -1.0]), weighted_median(cen[up, 2], area[up])
 
 
+def is_lid_plane(n: np.ndarray | None, config: ClipConfig) -> bool:
+    """Whether ``clip_part`` clipped to a lid's horizontal top (a front's plane is near-vertical)."""
+    return n is not None and abs(float(n[2])) > config.max_abs_nz
+
+
 def clip_part(mesh: TriMesh, face_ids: np.ndarray, camera_center: np.ndarray, config: ClipConfig) -> tuple[np.ndarray, np.ndarray | None, float | None]:
     """Faces of the slab, and the plane (normal pointing away from the camera, offset) or None.
 

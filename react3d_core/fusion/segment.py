@@ -17,7 +17,7 @@ from ..geometry import overlap_counts
 from ..perception.interfaces import PointPromptSegmenter
 from ..raster import Rasterizer
 from ..raster.rasterizer import RasterResult
-from .clip import clip_part
+from .clip import clip_part, is_lid_plane
 from .connectivity import largest_component
 from .lift import FrameLift, ViewStats, lift_with_stats
 from .proposals import FusionMesh, Proposal, fuse_proposals, prepare_fusion_mesh
@@ -107,6 +107,15 @@ def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh, config: FusionCon
     return kept
 
 
+def drop_lid_skirts(cands: list[PartCandidate], skirts: Sequence[tuple[int, np.ndarray]], share: float) -> list[PartCandidate]:
+    """``cands`` less those with more than ``share`` of their faces among a lid's re-segmented or proposal
+    faces (``skirts``: the lid's index in ``cands`` and those faces). Why: a lid is clipped to its top's plane, so
+    its lip and side skirts are left over, and a proposal made of them, re-segmented before the lid claimed
+    them, became a flap of its own beside the lid."""
+    return [c for k, c in enumerate(cands)
+            if not any(k != j and np.isin(c.face_ids, faces).mean() > share for j, faces in skirts)]
+
+
 def candidates_from_proposals(
     scene: SceneInput,
     mesh: TriMesh,
@@ -129,6 +138,7 @@ def candidates_from_proposals(
     out = []
     centroids = mesh.face_centroids
     claimed = np.zeros(mesh.n_faces, bool)
+    skirts: list[tuple[int, np.ndarray]] = []  # (candidate index, re-segmented faces) of each lid
     # best-seen proposals first; one mostly inside an earlier candidate would re-segment to it
     order = sorted(range(len(proposals)), key=lambda i: (-(tops[i][0].iou if tops[i] else 0.0), -len(proposals[i].face_ids)))
     outcomes = [ProposalOutcome("no_views") for _ in proposals]
@@ -152,6 +162,11 @@ def candidates_from_proposals(
         if not len(kept):
             continue
         claimed[kept] = True
+        if config.fusion.lid_claims_skirt and is_lid_plane(n, config.clip):
+            # the best view's mask may miss an end skirt that the fused proposal holds
+            skirt = np.union1d(np.asarray(faces, np.int64), prop.face_ids)
+            skirts.append((len(out), skirt))
+            claimed[skirt] = True
         out.append(
             PartCandidate(
                 candidate_id=len(out),
@@ -166,6 +181,7 @@ def candidates_from_proposals(
                 proposal_face_ids=prop.face_ids,
             )
         )
+    out = drop_lid_skirts(out, skirts, config.fusion.claimed_share)
     if trace is not None:
         trace.outcomes = outcomes
         trace.before_duplicates = list(out)

@@ -463,6 +463,7 @@ DEFAULTS = {
     "perception.heuristic.cells.max_split_depth": 6,
     "perception.heuristic.cells.outline_step": 0.5,
     "perception.heuristic.cells.knobs_any_side": True,
+    "perception.heuristic.cells.lone_knobs_block": True,
     "perception.heuristic.cells.edge_strip": 0.2,
     "perception.heuristic.cells.sliver_max": 0.13,
     "perception.heuristic.cells.sliver_ratio": 1.5,
@@ -500,6 +501,7 @@ DEFAULTS = {
     "fusion.duplicate_iou": 0.5,
     "fusion.duplicate_contained": 0.8,
     "fusion.claimed_share": 0.8,
+    "fusion.lid_claims_skirt": True,
     "fusion.max_anchors": 8,
     "fusion.distinct_jaccard": 0.95,
     # fusion/clip.py MAX_POINTS; scene_io/selection.py COVERAGE_VOXEL_M

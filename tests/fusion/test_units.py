@@ -295,3 +295,29 @@ def test_clip_keeps_a_lid_by_its_top_plane():
     # an upward area under lid_ratio times the vertical one is a front with something on top
     tall = merge(top, grid(0.0, 1.0, 0.0, 0.85, -0.3, 10, 20))[0]  # 0.85 m2 of front below the 0.6 m2 top
     assert abs(clip_part(tall, np.arange(tall.n_faces), cam, ClipConfig())[1][2]) < 1e-6
+
+
+def test_a_lids_skirts_make_no_candidate_of_their_own():
+    """A chest freezer's lid re-segmented to faces 0-99 (its top 0-79, its lip and side skirts 80-99) and
+    clipped to the top (faces 0-79): a skirt proposal re-segmented before the lid gave candidate 0 of faces
+    85-99, which all lie in the lid's re-segmented faces, so it goes; a door beside the chest (faces
+    200-259) and a candidate only 10 of whose 20 faces (90-109) the lid held (0.5, not over 0.8) stay.
+    A lid's own plane is horizontal: is_lid_plane says so for (0, 0, -1) and not for a front's tilted
+    2 degrees, nor for no plane."""
+    from react3d_core.fusion.clip import is_lid_plane
+    from react3d_core.fusion.segment import drop_lid_skirts
+    from react3d_core.data.parts import PartCandidate
+
+    def cand(i: int, faces: np.ndarray) -> PartCandidate:
+        return PartCandidate(candidate_id=i, face_ids=faces, vertex_ids=faces)
+
+    skirt, lid, door, half = (cand(0, np.arange(85, 100)), cand(1, np.arange(80)), cand(2, np.arange(200, 260)),
+                              cand(3, np.arange(90, 110)))
+    cands = [skirt, lid, door, half]
+    kept = drop_lid_skirts(cands, [(1, np.arange(100))], 0.8)
+    assert [c.candidate_id for c in kept] == [1, 2, 3]
+    assert len(drop_lid_skirts(cands, [], 0.8)) == 4  # no lid: nothing dropped
+    c = ClipConfig()
+    assert is_lid_plane(np.array([0.0, 0.0, -1.0]), c)
+    assert not is_lid_plane(np.array([np.cos(np.radians(2)), 0.0, -np.sin(np.radians(2))]), c)
+    assert not is_lid_plane(None, c)
