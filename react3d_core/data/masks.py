@@ -23,6 +23,7 @@ class Mask2D(BaseModel):
     score: float = 1.0
     mask: np.ndarray = Field(repr=False, description="bool HxW")
     box: tuple[float, float, float, float] | None = Field(None, description="x0, y0, x1, y1 (px)")
+    instance: int | None = Field(None, description="The perceived object this mask shows, the same in every frame, when the backend knows it (a 3D front rendered into each view); None for per-view detectors.")
 
     @property
     def area(self) -> int:
@@ -67,6 +68,7 @@ def save_masks(path: str | Path, masks: Sequence[Mask2D]) -> Path:
         label=np.array([m.label for m in masks], dtype=str),
         score=np.array([m.score for m in masks], dtype=float),
         box=boxes,
+        instance=np.array([-1 if m.instance is None else m.instance for m in masks], dtype=np.int64),
     )
 
 
@@ -75,6 +77,7 @@ def load_masks(path: str | Path) -> list[Mask2D]:
     z = read_npz(path)
     try:
         h, w = (int(x) for x in z["shape"])
+        inst = z["instance"] if "instance" in z else np.full(len(z["frame_id"]), -1)  # archives written before it
         out = []
         for i in range(len(z["frame_id"])):
             m = np.unpackbits(z["bits"][i], count=h * w).astype(bool).reshape(h, w)
@@ -86,6 +89,7 @@ def load_masks(path: str | Path) -> list[Mask2D]:
                     score=float(z["score"][i]),
                     mask=m,
                     box=None if np.isnan(box).any() else tuple(float(b) for b in box),
+                    instance=None if int(inst[i]) < 0 else int(inst[i]),
                 )
             )
         return out
@@ -93,7 +97,7 @@ def load_masks(path: str | Path) -> list[Mask2D]:
         raise InputError(path, f"mask archive lacks field {exc}") from None
 
 
-_Packed = tuple[bytes, tuple[int, int], str, str, float, "tuple | None"]
+_Packed = tuple[bytes, tuple[int, int], str, str, float, "tuple | None", "int | None"]
 
 
 class _PackedFrame(Sequence[Mask2D]):
@@ -108,9 +112,9 @@ class _PackedFrame(Sequence[Mask2D]):
     def __getitem__(self, i):  # noqa: ANN001, ANN204 - Sequence protocol (int or slice)
         if isinstance(i, slice):
             return [self[j] for j in range(*i.indices(len(self)))]
-        bits, (h, w), fid, label, score, box = self._packed[i]
+        bits, (h, w), fid, label, score, box, instance = self._packed[i]
         mask = np.unpackbits(np.frombuffer(bits, np.uint8), count=h * w).astype(bool).reshape(h, w)
-        return Mask2D(frame_id=fid, label=label, score=score, mask=mask, box=box)
+        return Mask2D(frame_id=fid, label=label, score=score, mask=mask, box=box, instance=instance)
 
 
 class PackedMasks(Mapping[str, Sequence[Mask2D]]):
@@ -127,7 +131,7 @@ class PackedMasks(Mapping[str, Sequence[Mask2D]]):
         """Store (replace) one frame's masks, packed."""
         self._frames[frame_id] = [
             (np.packbits(m.mask.astype(bool).ravel()).tobytes(), tuple(m.mask.shape), m.frame_id, m.label,
-             float(m.score), m.box) for m in masks]
+             float(m.score), m.box, m.instance) for m in masks]
 
     def __getitem__(self, frame_id: str) -> Sequence[Mask2D]:
         return _PackedFrame(self._frames[frame_id])

@@ -107,6 +107,44 @@ def drop_duplicates(cands: list[PartCandidate], mesh: TriMesh, config: FusionCon
     return kept
 
 
+def _instance(c: PartCandidate) -> int | None:
+    """The perceived object most of ``c``'s top views' masks show (ties: the best view's), or None."""
+    ids = [t.mask.instance for t in c.top_views if t.mask is not None and t.mask.instance is not None]
+    if not ids:
+        return None
+    vals, counts = np.unique(ids, return_counts=True)
+    best = vals[counts == counts.max()]
+    return ids[0] if ids[0] in best else int(best[0])
+
+
+def merge_instances(cands: list[PartCandidate], mesh: TriMesh) -> list[PartCandidate]:
+    """Join the candidates whose top views show one perceived object (``_instance``) into the best-scored of
+    them. Why: one object is one part; a front seen in pieces (a different piece past the clutter in each
+    view) fuses into pieces, and each piece, re-segmented in the views that see it, became a part."""
+    groups: dict[int, list[int]] = {}
+    for i, c in enumerate(cands):
+        k = _instance(c)
+        if k is not None:
+            groups.setdefault(k, []).append(i)
+    gone: set[int] = set()
+    for members in groups.values():
+        if len(members) < 2:
+            continue
+        members = sorted(members, key=lambda i: (-cands[i].score, -len(cands[i].face_ids)))
+        keep = cands[members[0]]
+        faces = np.unique(np.concatenate([cands[i].face_ids for i in members]))
+        keep.face_ids = faces
+        keep.vertex_ids = _vertex_ids(mesh, faces)
+        props = [cands[i].proposal_face_ids for i in members if cands[i].proposal_face_ids is not None]
+        if props:
+            keep.proposal_face_ids = np.unique(np.concatenate(props))
+        gone.update(members[1:])
+    out = [c for i, c in enumerate(cands) if i not in gone]
+    for i, c in enumerate(out):
+        c.candidate_id = i
+    return out
+
+
 def drop_lid_skirts(cands: list[PartCandidate], skirts: Sequence[tuple[int, np.ndarray]], share: float) -> list[PartCandidate]:
     """``cands`` less those with more than ``share`` of their faces among a lid's re-segmented or proposal
     faces (``skirts``: the lid's index in ``cands`` and those faces). Why: a lid is clipped to its top's plane, so
@@ -185,7 +223,8 @@ def candidates_from_proposals(
     if trace is not None:
         trace.outcomes = outcomes
         trace.before_duplicates = list(out)
-    return drop_duplicates(out, mesh, config.fusion)
+    out = drop_duplicates(out, mesh, config.fusion)
+    return merge_instances(out, mesh) if config.fusion.merge_instances else out
 
 
 def segment_parts(

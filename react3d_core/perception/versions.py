@@ -70,6 +70,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 38: knobs are handles by default, kept in patterns (pairs in a row or column; not a control panel's row);
 #     two knobs side by side are cut apart only at a seam; a knob-only cell is cut with a knob on one side
 # 39: no cut runs through a knob that stands alone (cells.lone_knobs_block)
-HEURISTIC_VERSION = "39"
+# 40: each mask names the front it shows (Mask2D.instance), the same in every frame
+HEURISTIC_VERSION = "40"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -501,6 +501,7 @@ DEFAULTS = {
     "fusion.duplicate_iou": 0.5,
     "fusion.duplicate_contained": 0.8,
     "fusion.claimed_share": 0.8,
+    "fusion.merge_instances": True,
     "fusion.lid_claims_skirt": True,
     "fusion.max_anchors": 8,
     "fusion.distinct_jaccard": 0.95,

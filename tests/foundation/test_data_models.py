@@ -33,15 +33,17 @@ def test_articulation_move_hand_computed() -> None:
 def test_masks_roundtrip(tmp_path: Path) -> None:
     rng = np.random.default_rng(0)
     ms = [Mask2D(frame_id=f"frame_{i:06d}", label="door", score=0.5 + 0.1 * i, mask=rng.random((12, 16)) > 0.5,
-                 box=(1.0, 2.0, 3.0, 4.0)) for i in range(3)]
+                 box=(1.0, 2.0, 3.0, 4.0), instance=(None, 0, 7)[i]) for i in range(3)]
     back = load_masks(save_masks(tmp_path / "m.npz", ms))
-    assert [(m.frame_id, m.label, m.score, m.box) for m in back] == [(m.frame_id, m.label, m.score, m.box) for m in ms]
+    assert [(m.frame_id, m.label, m.score, m.box, m.instance) for m in back] == \
+        [(m.frame_id, m.label, m.score, m.box, m.instance) for m in ms]
     assert all(np.array_equal(a.mask, b.mask) for a, b in zip(ms, back))
 
 
 def test_packed_masks_unpack_on_access() -> None:
     rng = np.random.default_rng(0)
-    a = [Mask2D(frame_id="f0", label="door", score=0.5, mask=rng.random((5, 11)) > 0.5, box=(1.0, 2.0, 3.0, 4.0)),
+    a = [Mask2D(frame_id="f0", label="door", score=0.5, mask=rng.random((5, 11)) > 0.5, box=(1.0, 2.0, 3.0, 4.0),
+                instance=3),
          Mask2D(frame_id="f0", mask=np.zeros((5, 11), bool))]
     pm = PackedMasks()
     pm.add("f0", a)
@@ -52,7 +54,7 @@ def test_packed_masks_unpack_on_access() -> None:
     assert len(got) == 2 and len(pm["f1"]) == 0
     for m, g in zip(a, [got[0], got[-1]]):
         assert g.mask.dtype == bool and np.array_equal(g.mask, m.mask)
-        assert (g.frame_id, g.label, g.score, g.box) == (m.frame_id, m.label, m.score, m.box)
+        assert (g.frame_id, g.label, g.score, g.box, g.instance) == (m.frame_id, m.label, m.score, m.box, m.instance)
     assert [np.array_equal(g.mask, m.mask) for g, m in zip(got[0:2], a)] == [True, True]
     with pytest.raises(IndexError):
         got[2]

@@ -321,3 +321,30 @@ def test_a_lids_skirts_make_no_candidate_of_their_own():
     assert is_lid_plane(np.array([0.0, 0.0, -1.0]), c)
     assert not is_lid_plane(np.array([np.cos(np.radians(2)), 0.0, -np.sin(np.radians(2))]), c)
     assert not is_lid_plane(None, c)
+
+
+def test_candidates_showing_one_perceived_object_are_one_part():
+    """Four candidates on a 2 x 2 m grid mesh: three pieces of one front (their top views' masks show
+    instance 4: two views of 4 and one of 9 for the third piece, so 4 by majority) and a door (instance 2).
+    The pieces join into the best-scored one (score 0.7), with all their faces and vertices; the door and a
+    candidate whose masks carry no instance (a per-view detector's) stay as they were."""
+    from react3d_core.data.parts import PartCandidate, TopView
+    from react3d_core.fusion.segment import merge_instances
+
+    mesh = grid(0.0, 2.0, 0.0, 2.0, 0.0, 10, 10)  # 200 faces
+    def view(inst):
+        return TopView(frame_id="f", iou=0.9, mask=Mask2D(frame_id="f", mask=np.zeros((2, 2), bool), instance=inst))
+
+    def cand(i, faces, score, insts):
+        f = np.asarray(faces)
+        return PartCandidate(candidate_id=i, score=score, face_ids=f, vertex_ids=np.unique(mesh.faces[f].ravel()),
+                             top_views=[view(k) for k in insts])
+
+    pieces = [cand(0, range(0, 20), 0.5, [4, 4]), cand(1, range(20, 50), 0.7, [4]), cand(2, range(50, 60), 0.6, [4, 4, 9])]
+    door, plain = cand(3, range(100, 140), 0.8, [2]), cand(4, range(150, 160), 0.9, [None])
+    out = merge_instances(pieces + [door, plain], mesh)
+    assert len(out) == 3 and [c.candidate_id for c in out] == [0, 1, 2]
+    joined = [c for c in out if len(c.face_ids) == 60][0]
+    assert joined.score == 0.7 and np.array_equal(joined.face_ids, np.arange(60))
+    assert np.array_equal(joined.vertex_ids, np.unique(mesh.faces[:60].ravel()))
+    assert sorted(len(c.face_ids) for c in out) == [10, 40, 60]

@@ -191,7 +191,7 @@ class HeuristicSegmenter:
         out = []
         for f in frames:
             out.append([Mask2D(frame_id=f.frame_id, label=self.model.fronts[k].kind or "openable", score=MASK_SCORE, mask=m,
-                               box=_box(m))
+                               box=_box(m), instance=int(k))
                         for k, m in self.model.masks(f)])
         return out
 
