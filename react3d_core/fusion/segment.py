@@ -176,7 +176,7 @@ def candidates_from_proposals(
     out = []
     centroids = mesh.face_centroids
     claimed = np.zeros(mesh.n_faces, bool)
-    skirts: list[tuple[int, np.ndarray]] = []  # (candidate index, re-segmented faces) of each lid
+    skirts: list[tuple[int, np.ndarray]] = []  # (candidate index, re-segmented and proposal faces) of each lid
     # best-seen proposals first; one mostly inside an earlier candidate would re-segment to it
     order = sorted(range(len(proposals)), key=lambda i: (-(tops[i][0].iou if tops[i] else 0.0), -len(proposals[i].face_ids)))
     outcomes = [ProposalOutcome("no_views") for _ in proposals]
