@@ -71,6 +71,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     two knobs side by side are cut apart only at a seam; a knob-only cell is cut with a knob on one side
 # 39: no cut runs through a knob that stands alone (cells.lone_knobs_block)
 # 40: each mask names the front it shows (Mask2D.instance), the same in every frame
-HEURISTIC_VERSION = "40"
+# 41: seams are read with the handles' pixels filled in along them (cells.seams_past_handles), and a straight seam
+#     just above a horizontal bar is the seam that edge pull hangs from: cut with the handle below it alone (cells.edge_pull)
+HEURISTIC_VERSION = "41"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -465,6 +465,8 @@ DEFAULTS = {
     "perception.heuristic.cells.knobs_any_side": True,
     "perception.heuristic.cells.lone_knobs_block": True,
     "perception.heuristic.cells.edge_strip": 0.2,
+    "perception.heuristic.cells.seams_past_handles": True,
+    "perception.heuristic.cells.edge_pull": 0.012,
     "perception.heuristic.cells.sliver_max": 0.13,
     "perception.heuristic.cells.sliver_ratio": 1.5,
     "perception.heuristic.cells.min_seen": 0.55,

@@ -31,6 +31,7 @@ _U8_MAX = 255  # largest 8-bit value; also the largest kernel medianBlur takes h
 _ACROSS_ROW = np.ones((1, 3), np.uint8)  # a pixel and its left/right neighbours ...
 _ACROSS_COL = np.ones((3, 1), np.uint8)  # ... and its upper/lower ones
 _MIN_LINES = 3  # a profile of fewer usable lines has no seam
+_EDGE_BAND_DIV = 3  # a cut may run through at most a third of a bar's box at each edge (its middle stays blocked)
 
 
 @dataclass
@@ -360,11 +361,19 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
     min_px = max(2, int(cells_cfg.min_side / o.res))
     blocked_c = np.zeros(coverage.shape[1], bool)  # no cut runs through a handle
     blocked_r = np.zeros(coverage.shape[0], bool)
+    pull_px = int(round(cells_cfg.edge_pull / o.res))
     for h in list(handles) + (list(lone) if cells_cfg.lone_knobs_block else []):
         blocked_c[h.box[0]:h.box[2]] = True
-        blocked_r[h.box[1]:h.box[3]] = True
+        # a horizontal bar's top rows may hold the seam it hangs from (its box is blurred over it)
+        e = min(pull_px, (h.box[3] - h.box[1]) // _EDGE_BAND_DIV) if h.horizontal and not h.knob else 0
+        blocked_r[h.box[1] + e:h.box[3]] = True
     col = np.where((o.n_views > 0)[..., None], o.color, np.nan)  # unseen pixels carry no colour
     g = col.mean(-1)
+    gs, cols = (g, g), (col, col)  # read by profiles over columns (vertical seams), over rows (horizontal ones)
+    if cells_cfg.seams_past_handles:
+        on_handle = handle_pixels(list(handles) + list(lone), coverage.shape)
+        gs = (fill_along(g, on_handle, 0), fill_along(g, on_handle, 1))
+        cols = (fill_along(col, on_handle, 0), fill_along(col, on_handle, 1))
     learned = None
     if lines is not None:
         along_c = np.zeros(coverage.shape[1], bool)  # columns of vertical handles, rows of horizontal ones
@@ -375,8 +384,8 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
             else:
                 along_c[h.box[0]:h.box[2]] = True
         learned = LearnedLines(lines[0], lines[1], cfg.lines.span, along_c, along_r)
-    cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, g, col, learned,
-                   int(cells_cfg.edge_strip / o.res))
+    cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, gs, cols, learned,
+                   int(cells_cfg.edge_strip / o.res), pull_px)
     for c in cells:
         c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     held = {id(h) for c in cells for h in c.handles}
@@ -386,10 +395,48 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
             min(cells, key=lambda c: np.hypot(max(c.c0 - x, 0.0, x - c.c1), max(c.r0 - y, 0.0, y - c.r1))).handles.append(h)
     out: list[Cell] = []
     for c in cells:
-        out += _split_handles(c, vert, horiz, coverage, min_px, g, p, learned)
+        for piece in _split_handles(c, vert, horiz, coverage, min_px, gs, p, learned):
+            out += _split_at_pulls(piece, gs[1], coverage, min_px, pull_px, p)
     if cells_cfg.sliver_max > 0:
         out = merge_slivers(out, int(cells_cfg.sliver_max / o.res), cells_cfg.sliver_ratio)
     return out
+
+
+def handle_pixels(handles: list[Handle], shape: tuple[int, int], grow: int = 1) -> np.ndarray:
+    """Bool image of the handles' pixels, grown by ``grow`` px (a blob's rim is blurred into the front)."""
+    m = np.zeros(shape, np.uint8)
+    for h in handles:
+        m[h.pixels[:, 1], h.pixels[:, 0]] = 1
+    if grow > 0 and m.any():
+        m = cv2.dilate(m, np.ones((2 * grow + 1, 2 * grow + 1), np.uint8))
+    return m.astype(bool)
+
+
+def fill_along(g: np.ndarray, mask: np.ndarray, axis: int) -> np.ndarray:
+    """``g`` with its ``mask`` pixels replaced, line by line along ``axis`` (1: rows, 0: columns), by the
+    linear blend of the nearest unmasked finite values before and after them on that line (the one there
+    is where the line ends or holds only NaN on one side). Why: a seam continues straight through what
+    hides it, so read along its own direction it is filled in, where an isotropic fill would smear the
+    front over it; a handle stands in a hole of the plane's surface (it is not on the plane), so its
+    nearest neighbours are often unseen."""
+    if not mask.any():
+        return g
+    if axis == 0:
+        return np.swapaxes(fill_along(np.swapaxes(g, 0, 1), mask.T, 1), 0, 1)
+    n = g.shape[1]
+    ar = np.arange(n)[None, :]
+    bad = np.isnan(g) if g.ndim == 2 else np.isnan(g).any(axis=tuple(range(2, g.ndim)))
+    src = mask | bad
+    left = np.maximum.accumulate(np.where(src, -1, ar), axis=1)
+    right = np.minimum.accumulate(np.where(src, n, ar)[:, ::-1], axis=1)[:, ::-1]
+    rows = np.arange(g.shape[0])[:, None]
+    tail = (slice(None), slice(None)) + (None,) * (g.ndim - 2)  # colour channels ride along
+    lo, hi = left >= 0, right < n
+    gl = np.where(lo[tail], g[rows, np.clip(left, 0, n - 1)], np.nan)
+    gr = np.where(hi[tail], g[rows, np.clip(right, 0, n - 1)], np.nan)
+    w = ((ar - left) / np.maximum(right - left, 1))[tail]
+    fill = np.where(np.isnan(gl), gr, np.where(np.isnan(gr), gl, gl + w * (gr - gl)))
+    return np.where(mask[tail], fill, g)
 
 
 def _part_handle(h: Handle, keep: np.ndarray) -> Handle | None:
@@ -603,14 +650,17 @@ def _plateau_middle(v: np.ndarray) -> int:
 
 
 def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: SeamConfig, q: CellConfig, min_px: int,
-           depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: np.ndarray,
-           col: np.ndarray, learned: LearnedLines | None = None, strip_px: int = 0) -> list[Cell]:
+           depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: tuple[np.ndarray, np.ndarray],
+           col: tuple[np.ndarray, np.ndarray], learned: LearnedLines | None = None, strip_px: int = 0, pull_px: int = 0) -> list[Cell]:
     """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at a line that
     ``learned`` line segments support, else at the most prominent seam by valley counts.
     Inside a cell holding handles, a horizontal cut must leave a handle on both sides (glossy fronts
     reflect horizontal table and shelf edges at a constant height; a drawer above a door carries its own
     handle) — unless the side without one is a strip at most ``strip_px`` tall along the cell's top or
-    bottom edge (``cells.edge_strip``): a plinth or a worktop's edge, cut off and dropped."""
+    bottom edge (``cells.edge_strip``): a plinth or a worktop's edge, cut off and dropped; or the cut is a
+    straight dark seam (a dip, not a valley count: a bar's own rim makes those) within ``pull_px`` of a
+    horizontal bar's top edge (``cells.edge_pull``): the seam an edge pull hangs from, whose front's
+    neighbour above shows no handle when its own pull lies on the outline."""
     if depth >= q.max_split_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
@@ -624,14 +674,14 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
             else:
                 a = Cell(c.c0, c.r0, c.c1, c.r0 + oh, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
                 b = Cell(c.c0, c.r0 + oh + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
-            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px)
-                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px))
-    cv_, sc_v = _dip_cut(g[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
-    ch_, sc_h = _dip_cut(g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
+            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px, pull_px)
+                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px, pull_px))
+    cv_, sc_v = _dip_cut(g[0][sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
+    ch_, sc_h = _dip_cut(g[1][sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
     if p.ridges and not any(c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1 for h in handles):
         # a handle-less cell: a straight row brighter than both sides along the whole cell is a seam too
         # (the top edge of the drawer below, lit from above; a vertical gap catches no such light)
-        rh_, rs_h = _dip_cut(-g[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
+        rh_, rs_h = _dip_cut(-g[1][sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
         if rs_h > sc_h:
             ch_, sc_h = rh_, rs_h
     sc_v = sc_v if sc_v >= p.dip_z else 0.0
@@ -641,8 +691,8 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
         # a colour step along the whole cell (a front of another colour than its surround or its
         # neighbour); with ``step_over_dip`` it wins where it is stronger than the best dark line (a
         # shaker door's frame casts a straight dark line a few cm inside its own edge)
-        sv_, st_v = _dip_cut(col[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1], _step_scores)
-        sh_, st_h = _dip_cut(col[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1], _step_scores)
+        sv_, st_v = _dip_cut(col[0][sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1], _step_scores)
+        sh_, st_h = _dip_cut(col[1][sl], cov[sl], 1, min_px, p, br[c.r0:c.r1], _step_scores)
         st_v = st_v if st_v >= p.step_z else 0.0
         st_h = st_h if st_h >= p.step_z else 0.0
         if st_v > sc_v:
@@ -667,12 +717,12 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
     if sc_h and mine and not (q.knobs_any_side and all(h.knob for h in mine)):
         cut = c.r0 + ch_
         above, below = any(h.center[1] < cut for h in mine), any(h.center[1] > cut for h in mine)
-        if not (above and below):
+        if not (above and below) and not (dip_h and sc_h >= sc_v and _hangs_from(mine, cut, pull_px)):
             if sc_h >= sc_v and _edge_strip(c, cut, above, strip_px, mine):
                 # the strip is no front: the cell goes on without it, its sides as they were
                 rest = (Cell(c.c0, c.r0, c.c1, cut, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts) if above
                         else Cell(c.c0, cut + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts))
-                return _split(rest, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px)
+                return _split(rest, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px)
             sc_h = 0.0
     if max(sc_v, sc_h) == 0.0:
         return [c]
@@ -690,8 +740,41 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
                 b.seam_cuts = c.seam_cuts
             elif b.r1 - b.r0 <= strip_px < a.r1 - a.r0:
                 a.seam_cuts = c.seam_cuts
-    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px)
-            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px))
+    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px)
+            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px))
+
+
+def _split_at_pulls(c: Cell, g: np.ndarray, cov: np.ndarray, min_px: int, pull_px: int, p: SeamConfig) -> list[Cell]:
+    """Cut a cell along the seam an edge pull hangs from: for its horizontal bar lowest down first, the row
+    within ``pull_px`` above the bar's top edge where the brightness (``g``, handles filled in along rows)
+    dips most, when that dip scores at least ``seams.between_z`` noise units (the bar vouches for the seam
+    as a second handle does in ``_between``) and leaves ``min_px`` rows above. Why: a chest's lips sit on
+    the seams above them; with the top drawer's lip on the outline, each seam had a handle below and none
+    above, and a white-on-white TSDF seam is too faint for a straight cut by itself (``seams.dip_z``)."""
+    if pull_px <= 0:
+        return [c]
+    bars = sorted((h for h in c.handles if h.horizontal and not h.knob), key=lambda h: -h.box[1])
+    for h in bars:
+        lo, hi = h.box[1] - pull_px, h.box[1] + 1
+        if lo - c.r0 < min_px:
+            continue
+        sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
+        z = _dip_scores(g[sl], cov[sl], 1, min_px, p)[lo - c.r0:hi - c.r0]
+        if not len(z) or z.max() < p.between_z:
+            continue
+        cut = lo + int(np.argmax(z))
+        a = Cell(c.c0, c.r0, c.c1, cut, [k for k in c.handles if k.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
+        b = Cell(c.c0, cut + 1, c.c1, c.r1, [k for k in c.handles if k.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
+        return _split_at_pulls(a, g, cov, min_px, pull_px, p) + [b]
+    return [c]
+
+
+def _hangs_from(handles: list[Handle], cut: int, pull_px: int) -> bool:
+    """Whether a horizontal bar among ``handles`` has its top edge within ``pull_px`` rows of the horizontal
+    cut at row ``cut``: an edge pull hanging from the seam above it, a lip along a drawer's top edge (a bar
+    mounted on a front stands clear of its edges; a reflected shelf edge lines up with no handle's edge).
+    Only the top edge: under a bar lie its own shadow and, on an oven's drop door, the window's top rail."""
+    return pull_px > 0 and any(h.horizontal and not h.knob and abs(h.box[1] - cut) <= pull_px for h in handles)
 
 
 def _edge_strip(c: Cell, cut: int, above: bool, strip_px: int, handles: list[Handle]) -> bool:
@@ -737,7 +820,7 @@ def _nested(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
     return (a[0] <= b[0] and b[2] <= a[2]) or (b[0] <= a[0] and a[2] <= b[2])
 
 
-def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: np.ndarray,
+def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: tuple[np.ndarray, np.ndarray],
                    p: SeamConfig, learned: LearnedLines | None = None) -> list[Cell]:
     """Split a cell between consecutive handles (side by side: at the best column between them;
     stacked: at the best row), recursively, so every cell ends with at most one handle per row/column."""
@@ -759,7 +842,7 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
             lo, hi = int(xs[k]), int(xs[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
         knobs = p.knob_seam and hs[k].knob and hs[k + 1].knob
-        at = _between(g[rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
+        at = _between(g[0][rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
                       None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
                       (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0), seam_only=knobs)
         if at is None:
@@ -777,7 +860,7 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         if hi - lo < 2:
             lo, hi = int(ys[k]), int(ys[k + 1])
         rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
-        cut = c.r0 + _between(g[rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p,
+        cut = c.r0 + _between(g[1][rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p,
                               None if learned is None else learned.horiz[rs, cs], 1.0 if learned is None else learned.span,
                               (int(ys[k]) - c.r0, int(ys[k + 1]) - c.r0))
         a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)

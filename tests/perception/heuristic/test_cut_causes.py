@@ -70,7 +70,7 @@ def test_cut_between_stacked_handles_finds_the_seam_inside_a_handle_box() -> Non
     assert _between(g, ev, cov, 1, 26, 55, 25, p, centres=(23, 82)) == 58
     drawer = Handle((30, 20, 70, 26), True, np.zeros((0, 2), int))     # centre row 23
     door = Handle((80, 55, 86, 110), False, np.zeros((0, 2), int))     # centre row 82.5
-    a, b = sorted(_split_handles(Cell(0, 0, 100, 150, [drawer, door]), ev, ev, cov, 25, g, p), key=lambda c: c.r0)
+    a, b = sorted(_split_handles(Cell(0, 0, 100, 150, [drawer, door]), ev, ev, cov, 25, (g, g), p), key=lambda c: c.r0)
     assert (a.r1, b.r0) == (58, 59) and a.handles == [drawer] and b.handles == [door]
 
 

@@ -71,5 +71,5 @@ def test_a_bar_across_anothers_columns_is_not_beside_it() -> None:
     cov = np.ones(g.shape, bool)
     ev = np.zeros(g.shape, bool)
     bar, rail = _bar(10, 18, 40, 80), Handle((5, 100, 115, 108), True, np.zeros((0, 2), int))
-    out = _split_handles(Cell(0, 0, 120, 150, [bar, rail]), ev, ev, cov, 25, g, SeamConfig())
+    out = _split_handles(Cell(0, 0, 120, 150, [bar, rail]), ev, ev, cov, 25, (g, g), SeamConfig())
     assert len(out) == 1 and out[0].handles == [bar, rail]

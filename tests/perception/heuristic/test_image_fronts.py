@@ -336,7 +336,7 @@ def test_split_between_handles_ends_on_overlapping_bars() -> None:
     c = Cell(0, 0, 300, 200, [h1, h2])
     ev = np.zeros((200, 300), bool)
     ev[:, 150] = True
-    cells = _split_handles(c, ev, ev, np.ones((200, 300), bool), 20, np.ones((200, 300)), SeamConfig())
+    cells = _split_handles(c, ev, ev, np.ones((200, 300), bool), 20, (np.ones((200, 300)),) * 2, SeamConfig())
     assert sum(len(x.handles) for x in cells) == 2 and all(x.handles for x in cells)
 
 
