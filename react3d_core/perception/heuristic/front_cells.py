@@ -372,8 +372,8 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
     gs, cols = (g, g), (col, col)  # read by profiles over columns (vertical seams), over rows (horizontal ones)
     if cells_cfg.seams_past_handles:
         on_handle = handle_pixels(list(handles) + list(lone), coverage.shape)
-        gs = (fill_along(g, on_handle, 0), fill_along(g, on_handle, 1))
         cols = (fill_along(col, on_handle, 0), fill_along(col, on_handle, 1))
+        gs = (cols[0].mean(-1), cols[1].mean(-1))  # the blend is linear and a pixel is NaN in every channel or none
     learned = None
     if lines is not None:
         along_c = np.zeros(coverage.shape[1], bool)  # columns of vertical handles, rows of horizontal ones
