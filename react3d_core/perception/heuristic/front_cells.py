@@ -32,6 +32,7 @@ _ACROSS_ROW = np.ones((1, 3), np.uint8)  # a pixel and its left/right neighbours
 _ACROSS_COL = np.ones((3, 1), np.uint8)  # ... and its upper/lower ones
 _MIN_LINES = 3  # a profile of fewer usable lines has no seam
 _EDGE_BAND_DIV = 3  # a cut may run through at most a third of a bar's box at each edge (its middle stays blocked)
+_PAIR_BAND_DIV = 3  # a cut may run through the middle third of a bar pair's box (its outer thirds stay blocked)
 
 
 @dataclass
@@ -362,8 +363,12 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
     blocked_c = np.zeros(coverage.shape[1], bool)  # no cut runs through a handle
     blocked_r = np.zeros(coverage.shape[0], bool)
     pull_px = int(round(cells_cfg.edge_pull / o.res))
+    pair_px = int(np.ceil(2 * cfg.handles.thickness[0] / o.res)) if cells_cfg.bar_pairs else 0
     for h in list(handles) + (list(lone) if cells_cfg.lone_knobs_block else []):
         blocked_c[h.box[0]:h.box[2]] = True
+        if _bar_pair(h, pair_px):  # its middle may hold the seam where two doors meet
+            w = h.box[2] - h.box[0]
+            blocked_c[h.box[0] + w // _PAIR_BAND_DIV:h.box[2] - w // _PAIR_BAND_DIV] = False
         # a horizontal bar's top rows may hold the seam it hangs from (its box is blurred over it)
         e = min(pull_px, (h.box[3] - h.box[1]) // _EDGE_BAND_DIV) if h.horizontal and not h.knob else 0
         blocked_r[h.box[1] + e:h.box[3]] = True
@@ -386,6 +391,8 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
         learned = LearnedLines(lines[0], lines[1], cfg.lines.span, along_c, along_r)
     cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, gs, cols, learned,
                    int(cells_cfg.edge_strip / o.res), pull_px)
+    if pair_px:
+        handles = _split_bar_pairs(handles, cells, pair_px)
     for c in cells:
         c.handles = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
     held = {id(h) for c in cells for h in c.handles}
@@ -395,10 +402,37 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
             min(cells, key=lambda c: np.hypot(max(c.c0 - x, 0.0, x - c.c1), max(c.r0 - y, 0.0, y - c.r1))).handles.append(h)
     out: list[Cell] = []
     for c in cells:
-        for piece in _split_handles(c, vert, horiz, coverage, min_px, gs, p, learned):
+        pitched = _pitch_split(c, gs[1], coverage, min_px, p, cells_cfg.pitch_tol) if cells_cfg.pitch_tol > 0 else None
+        for piece in pitched or _split_handles(c, vert, horiz, coverage, min_px, gs, p, learned):
             out += _split_at_pulls(piece, gs[1], coverage, min_px, pull_px, p)
     if cells_cfg.sliver_max > 0:
         out = merge_slivers(out, int(cells_cfg.sliver_max / o.res), cells_cfg.sliver_ratio)
+    return out
+
+
+def _bar_pair(h: Handle, pair_px: int) -> bool:
+    """Whether ``h`` is a vertical bar at least ``pair_px`` wide (two bars' thickness; 0: never)."""
+    return pair_px > 0 and not h.horizontal and not h.knob and h.box[2] - h.box[0] >= pair_px
+
+
+def _split_bar_pairs(handles: list[Handle], cells: list[Cell], pair_px: int) -> list[Handle]:
+    """Each wide vertical bar (``_bar_pair``) that a cell's side runs through, between its rows, as two
+    handles: its pixels either side of that column. Why: where two doors meet, their bars either side of the
+    seam fuse into one blob (in the colour and in the mesh at 1 cm); once the seam is cut through the blob's
+    middle, each door holds its own bar."""
+    out = []
+    for h in handles:
+        cut = None
+        if _bar_pair(h, pair_px):
+            w = h.box[2] - h.box[0]
+            lo, hi = h.box[0] + w // _PAIR_BAND_DIV, h.box[2] - w // _PAIR_BAND_DIV
+            y = h.center[1]
+            cut = next((c.c1 for c in cells if lo <= c.c1 < hi and c.r0 <= y < c.r1), None)
+        if cut is None:
+            out.append(h)
+            continue
+        out += [part for part in (_part_handle(h, h.pixels[:, 0] < cut), _part_handle(h, h.pixels[:, 0] > cut))
+                if part is not None]
     return out
 
 
@@ -625,6 +659,50 @@ def _outline_cut(cov: np.ndarray, axis: int, min_px: int, blocked: np.ndarray) -
     return cut, float(jump[i])
 
 
+def _groove_cut(cov: np.ndarray, axis: int, min_px: int, q: CellConfig, blocked: np.ndarray,
+                piece_sides: int) -> tuple[int, float]:
+    """The middle of the widest band of lines across ``axis`` at most ``q.groove_px`` wide whose coverage is
+    under ``q.groove_share`` of the cell's median line coverage, along the whole cell (in every piece
+    ``piece_sides`` x ``min_px`` long), the ``min_px`` lines on each side covered at least half that level
+    (median) and reaching it within ``groove_px`` / 2 lines of the band (steep walls), on a cell whose median
+    line is covered ``groove_cover`` of its length (index in the cell, 1.0); else (-1, 0.0). Why: on a 1 cm TSDF mesh the 4 mm gap between two fronts
+    is a groove 2-3 cm wide where the surface leaves the plane, unseen in the orthophoto too, so the
+    seam shows no dark line to cut at, only a gap."""
+    n = cov.sum(axis).astype(float)
+    m = len(n)
+    if m <= 2 * min_px + 1 or not n.any():
+        return -1, 0.0
+    level = float(np.median(n[n > 0]))
+    if level < q.groove_cover * cov.shape[axis]:
+        return -1, 0.0  # a patchy plane: its holes line up by chance
+    low = n < q.groove_share * level
+    length = cov.shape[axis]
+    pieces = max(1, length // max(1, piece_sides * min_px))
+    if pieces > 1:  # low in every piece where the lines beside it are covered
+        for cp in np.array_split(cov, pieces, axis):
+            npc = cp.sum(axis).astype(float)
+            lev = float(np.median(npc[npc > 0])) if npc.any() else 0.0
+            low &= npc < q.groove_share * max(lev, 1.0)
+    lab, k = ndimage.label(low)
+    wall = max(2, q.groove_px // 2)
+    best, width = -1, 0
+    for j in range(1, k + 1):
+        idx = np.flatnonzero(lab == j)
+        a, b = int(idx[0]), int(idx[-1])
+        w = b - a + 1
+        if w > q.groove_px or a - min_px < 0 or b + min_px >= m:
+            continue
+        if min(np.median(n[a - min_px:a]), np.median(n[b + 1:b + 1 + min_px])) < 0.5 * level:
+            continue
+        if min(n[a - wall:a].max(), n[b + 1:b + 1 + wall].max()) < 0.5 * level:
+            continue  # a groove's walls are steep; an occluder's shadow or a hole's ragged edge slopes
+        mid = (a + b) // 2
+        if blocked[mid] or w <= width:
+            continue
+        best, width = mid, w
+    return (best, 1.0) if best >= 0 else (-1, 0.0)
+
+
 def _line_cut(ev: np.ndarray, cov: np.ndarray, axis: int, min_px: int, span: float, chunks: int,
               blocked: np.ndarray) -> tuple[int, float]:
     """Best split line on learned line evidence ``ev`` (index in the cell, share of the cell's covered
@@ -700,6 +778,11 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
         if st_h > sc_h:
             ch_, sc_h, dip_h = sh_, st_h, False
     straight = int(dip_v if sc_v >= sc_h else dip_h) if max(sc_v, sc_h) > 0.0 else 0
+    if max(sc_v, sc_h) == 0.0 and q.groove_share > 0:
+        # a groove: a narrow band the scan's surface leaves along the whole cell (a TSDF seam)
+        cv_, sc_v = _groove_cut(cov[sl], 0, min_px, q, bc[c.c0:c.c1], p.piece_sides)
+        ch_, sc_h = _groove_cut(cov[sl], 1, min_px, q, br[c.r0:c.r1], p.piece_sides)
+        straight = int(max(sc_v, sc_h) > 0.0)
     if max(sc_v, sc_h) == 0.0 and learned is not None:
         # a straight line that the learned segments of several views agree on (a seam in a glossy or
         # evenly lit front shows no dark line)
@@ -818,6 +901,44 @@ def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int,
 def _nested(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
     """Whether the columns of one pixel box lie within those of the other."""
     return (a[0] <= b[0] and b[2] <= a[2]) or (b[0] <= a[0] and a[2] <= b[2])
+
+
+def _pitch_split(c: Cell, g: np.ndarray, cov: np.ndarray, min_px: int, p: SeamConfig, tol: float) -> list[Cell] | None:
+    """A cell holding a column of two or more horizontal bars at one pitch P (each step within ``tol`` x P of
+    their median), and k = n or n + 1 pitches tall (within ``tol`` x P), with no straight seam
+    (``seams.between_z``) anywhere between two of them: cut into k drawers of equal height, each bar in
+    its own (None where the cell is not such a stack).
+
+    Why: between two bars and no seam, the cut fell halfway, right for centred handles but half a drawer off
+    for edge pulls along the drawers' top edges (a white TSDF chest shows no seam; its top drawer's pull lies
+    on the outline and is not found, hence n + 1). A stack of equal drawers puts its seams on the pitch
+    grid anchored at the cell's edges whichever way its handles sit."""
+    hs = sorted(c.handles, key=lambda h: h.center[1])
+    n = len(hs)
+    if n < 2 or not all(h.horizontal and not h.knob for h in hs):
+        return None
+    ys = np.array([h.center[1] for h in hs])
+    steps = np.diff(ys)
+    pitch = float(np.median(steps))
+    if pitch < min_px or np.abs(steps - pitch).max() > tol * pitch:
+        return None
+    if min(h.box[2] for h in hs) <= max(h.box[0] for h in hs):
+        return None  # not one column: some bars share no columns
+    height = c.r1 - c.r0
+    k = int(round(height / pitch))
+    if k not in (n, n + 1) or abs(height - k * pitch) > tol * pitch:
+        return None
+    sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
+    z = _dip_scores(g[sl], cov[sl], 1, min_px, p)
+    if len(z) and z[int(ys[0]) - c.r0:int(ys[-1]) - c.r0 + 1].max(initial=0.0) >= p.between_z:
+        return None  # a seam shows: the usual cuts find it
+    cuts = [c.r0 + int(round(j * height / k)) for j in range(1, k)]
+    edges = [c.r0] + cuts + [c.r1]
+    out = [Cell(c.c0, a if j == 0 else a + 1, c.c1, b, [h for h in hs if a <= h.center[1] < b],
+                c.cut_sides + (j > 0) + (j < k - 1), c.seam_cuts) for j, (a, b) in enumerate(zip(edges[:-1], edges[1:]))]
+    if any(len(x.handles) > 1 for x in out) or sum(len(x.handles) for x in out) != n:
+        return None
+    return out
 
 
 def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: tuple[np.ndarray, np.ndarray],

@@ -559,7 +559,9 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                 mine.append(f)
                 if not tiled and 0 < cfg.cells.handleless_min_seams <= cell.seam_cuts:
                     gridded.add(id(f))
-        if (not tiled and piece_of_fronts(mine, o, cov, cfg)
+        # a plane that only averaged normals found may be any small panel (a chair's back, a piece's side):
+        # its fronts need a handle, not only the piece standing free
+        if (not tiled and not o.plane.averaged and piece_of_fronts(mine, o, cov, cfg)
                 and (not cfg.cells.piece_behind or stands_in_room(mesh, o.plane, cfg.room_wall))):
             pieces.update(id(f) for f in mine)
         if cfg.portholes.enabled:

@@ -16,7 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, sparse
 
 from ...config.heuristic import PlanesConfig
 from ...data.mesh import TriMesh
@@ -46,6 +46,7 @@ class Plane:
     extent_u: tuple[float, float]
     extent_v: tuple[float, float]
     area: float
+    averaged: bool = False  # found only by normals averaged over neighbouring faces (the last vote)
 
     def to_world(self, uu: np.ndarray, vv: np.ndarray, depth: float = 0.0) -> np.ndarray:
         """Points at in-plane coordinates (uu, vv=z), ``depth`` in front of the plane."""
@@ -92,8 +93,10 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
     if not vert.any():
         return []
     # orientation-free direction of every face's normal over [0, 180) degrees
-    theta = np.degrees(np.arctan2(nrm[:, 1], nrm[:, 0])) % _HALF_TURN
-    vidx = np.flatnonzero(vert)
+    theta = _direction_deg(nrm)
+    ns = smoothed_normals(mesh, cfg.smooth_rings) if cfg.smooth_rings > 0 else nrm
+    vert_s = (np.abs(ns[:, 2]) <= max_tilt) & (area > 0)
+    vidx = np.flatnonzero(vert | vert_s)
     sp, sf, sw = surface_samples(mesh.vertices[mesh.faces[vidx]], area[vidx], cfg.cell / _SAMPLES_PER_CELL)
     samples = _Samples(sp, vidx[sf], sw, np.zeros(len(cen), bool))
     planes, found = _vote(vert, theta, area, cen, samples, cfg, min_area, [])
@@ -105,6 +108,20 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
             break
         planes += more
         found += dirs
+    if cfg.smooth_rings > 0:
+        # a piece turned a few degrees from a TSDF scan's voxel grid is a staircase: its faces' normals
+        # spread over 40 degrees and no direction peaks; averaged over a few rings of neighbours they agree.
+        # Only the faces no plane explains vote so: the planes found from raw normals stay as they are
+        # (averaged everywhere, normals bend round every edge and handle and move those planes)
+        # Any direction: a chest turned 5 degrees from the wall it stands at peaks within the separation
+        # kept from the walls' own peak, whose faces are explained by then.
+        # Their averaged normals still spread by +-5 degrees, so a lower peak is enough to be voted on; the
+        # plane must still hold min_area.
+        more, _ = _vote(vert_s & ~_explained(planes, cen, cfg), _direction_deg(ns), area, cen, samples,
+                        cfg.model_copy(update={"direction_peak_div": cfg.smooth_peak_div}), min_area, [])
+        for p in more:
+            p.averaged = True
+        planes += more
     signs = outward_signs(planes, nrm, area, cam_center, view_dirs, cfg.normal_agree)
     out = [p if sg > 0 else _flip(p) for p, sg in zip(planes, signs)]
     out.sort(key=lambda p: -p.area)
@@ -159,6 +176,24 @@ def _explained(planes: list[Plane], cen: np.ndarray, cfg: PlanesConfig) -> np.nd
                   & (vv >= p.extent_v[0] - cfg.cell) & (vv <= p.extent_v[1] + cfg.cell))
         out[near[inside]] = True
     return out
+
+
+def _direction_deg(nrm: np.ndarray) -> np.ndarray:
+    """Orientation-free directions (deg, [0, 180)) of the normals ``nrm`` (N, 3) projected on the floor."""
+    return np.degrees(np.arctan2(nrm[:, 1], nrm[:, 0])) % _HALF_TURN
+
+
+def smoothed_normals(mesh: TriMesh, rings: int) -> np.ndarray:
+    """Face normals averaged (area-weighted) over the faces within ``rings`` steps through shared vertices,
+    unit length. Sparse face-vertex incidence products: linear in the mesh size."""
+    f = mesh.faces
+    nf = len(f)
+    inc = sparse.csr_matrix((np.ones(f.size), (f.ravel(), np.repeat(np.arange(nf), f.shape[1]))),
+                            shape=(len(mesh.vertices), nf))
+    n = mesh.face_normals * mesh.face_areas[:, None]
+    for _ in range(rings):
+        n = inc.T @ (inc @ n)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
 
 
 def _direction(n: np.ndarray) -> float:
@@ -364,7 +399,7 @@ def _longest_run(t: np.ndarray, step: float) -> float:
 
 def _flip(p: Plane) -> Plane:
     u = horizontal_right(-p.n)
-    return Plane(-p.n, u, -p.d, p.faces, (-p.extent_u[1], -p.extent_u[0]), p.extent_v, p.area)
+    return Plane(-p.n, u, -p.d, p.faces, (-p.extent_u[1], -p.extent_u[0]), p.extent_v, p.area, p.averaged)
 
 
 def _pieces(sel: np.ndarray, samples: _Samples, area: np.ndarray, n: np.ndarray, d: float, cell: float,

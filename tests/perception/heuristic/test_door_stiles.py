@@ -47,8 +47,9 @@ def test_glass_doors_meeting_at_fused_handles_give_two_doors() -> None:
     fused into one handle over columns 80-99. The cut may not run through the handle, so the guillotine cuts
     at the frame edges 76 (the first of the equal dips) and then 104 (27 px from the cell's edge, over
     cells.min_side = 25 px; 14 and 166 are closer to an edge): a 27 px = 10.8 cm sliver [77, 104). With the
-    sliver rule the doors meet at its middle, (77 + 104) // 2 = 90, each with half of the handle. Off: three
-    cells."""
+    sliver rule the doors meet at its middle, (77 + 104) // 2 = 90, each with half of the handle. Off (and
+    ``cells.bar_pairs`` off): three cells. With the bar-pair rule alone the seam itself is cut through the
+    handle's middle third, at column 90 too."""
     img = np.ones((150, 180, 3), np.float32)
     img[:, 90] *= 0.75
     img[:, [14, 76, 104, 166]] *= 0.8
@@ -58,8 +59,10 @@ def test_glass_doors_meeting_at_fused_handles_give_two_doors() -> None:
     on = sorted(split_cells(o, cov, [fused], HeuristicConfig()), key=lambda c: c.c0)
     assert [(c.c0, c.c1) for c in on] == [(0, 90), (91, 180)]
     assert [h.box for h in on[0].handles] == [(80, 20, 90, 82)] and [h.box for h in on[1].handles] == [(91, 20, 100, 82)]
-    off = split_cells(o, cov, [fused], HeuristicConfig(cells={"sliver_max": 0.0}))
+    off = split_cells(o, cov, [fused], HeuristicConfig(cells={"sliver_max": 0.0, "bar_pairs": False}))
     assert [(c.c0, c.c1) for c in sorted(off, key=lambda c: c.c0)] == [(0, 76), (77, 104), (105, 180)]
+    pairs = sorted(split_cells(o, cov, [fused], HeuristicConfig(cells={"sliver_max": 0.0})), key=lambda c: c.c0)
+    assert [(c.c0, c.c1) for c in pairs] == [(0, 90), (91, 180)]
 
 
 def test_a_bar_across_anothers_columns_is_not_beside_it() -> None:

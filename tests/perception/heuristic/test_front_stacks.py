@@ -6,8 +6,10 @@ from __future__ import annotations
 import numpy as np
 
 from react3d_core.config.heuristic import FrontRulesConfig
+from react3d_core.perception.heuristic.front_cells import Handle
 from react3d_core.perception.heuristic.fronts import Front
 from react3d_core.perception.heuristic.image_fronts import stacks
+from react3d_core.perception.heuristic.orthophoto import Orthophoto
 
 N = np.array([0.0, -1.0, 0.0])      # facing -y; u = z x n = (1, 0, 0)
 U = np.array([1.0, 0.0, 0.0])
@@ -131,3 +133,106 @@ def test_a_faint_seam_over_an_edge_pull_is_cut() -> None:
         got[pull] = sorted((c.r0, c.r1) for c in split_cells(o, cov, hs, cfg))
     assert not any(abs(r1 - 60) <= 3 for _, r1 in got[0.0])
     assert len(got[0.012]) == 3 and all(abs(a[1] - b) <= 2 for a, b in zip(got[0.012], (60, 120)))
+
+
+def _door_pair_with_groove() -> tuple[Orthophoto, np.ndarray, Handle]:
+    """A 0.8 x 0.64 m door pair (200 x 160 px at 4 mm) as a 1 cm TSDF scan shows it: the seam where the doors
+    meet is a groove 7 px wide (columns 97-103) the surface leaves along the whole height, unseen and
+    uncovered; the doors' bars either side of it (columns 88-96 and 104-112, rows 20-80) fused into one blob
+    across it, a handle 25 px wide. Nothing else on the doors makes a line."""
+    from tests.perception.heuristic.flat_orthos import flat_ortho
+
+    rng = np.random.default_rng(7)
+    img = np.full((160, 200, 3), 0.7, np.float32) + rng.normal(0, 0.003, (160, 200, 3)).astype(np.float32)
+    img[20:80, 88:97] = img[20:80, 104:113] = 0.2
+    o = flat_ortho(img)
+    cov = np.ones(img.shape[:2], bool)
+    cov[:, 97:104] = False
+    o.n_views[~cov] = 0
+    rows, cols = np.mgrid[20:80, 88:113]
+    return o, cov, Handle((88, 20, 113, 80), False, np.stack([cols.ravel(), rows.ravel()], 1))
+
+
+def test_a_door_pair_is_cut_along_its_groove_through_its_fused_bars() -> None:
+    """Without the groove rule (``cells.groove_share`` 0) the seam shows no dark line to cut at (it is unseen),
+    and without the bar-pair rule (``cells.bar_pairs``) the one handle blocks every column it covers: one
+    cell either way. With both, the cut runs along the groove's middle (column 100) and each door holds its
+    own bar: the handle's pixels either side of the cut."""
+    from react3d_core.config.heuristic import HeuristicConfig
+    from react3d_core.perception.heuristic.front_cells import split_cells
+
+    o, cov, bar = _door_pair_with_groove()
+    for cells in ({"groove_share": 0.0}, {"bar_pairs": False}):
+        assert len(split_cells(o, cov, [bar], HeuristicConfig(cells=cells))) == 1
+    left, right = sorted(split_cells(o, cov, [bar], HeuristicConfig()), key=lambda c: c.c0)
+    assert left.c1 == 100 and right.c0 == 101
+    ((a,), (b,)) = left.handles, right.handles
+    assert a.box == (88, 20, 100, 80) and b.box == (101, 20, 113, 80)
+
+
+def test_groove_cut_hand_computed() -> None:
+    """Line coverage (a 40-line cell, 30 px along each line, one piece): 30 everywhere but a band. The cell's
+    median line coverage is 30; under 0.3 x 30 = 9 is a groove line. Lines 18-21 at 5 px: a 4-line groove,
+    cut at its middle, line 19; ten lines covered on each side. A band at 10 px (over 9) is none; a band
+    wider than groove_px is none, and so is one whose middle is blocked (a handle). A band uncovered in its
+    first 25 px only (5 px covered per line: low over the whole line) is a groove judged as one piece, but
+    none judged in pieces of 10 px (``piece_sides`` 1): in the last piece it is covered 5 of 10, over
+    0.3 x 10. A cell whose median line is covered under ``groove_cover`` of its length is patchy: none."""
+    from react3d_core.config.heuristic import CellConfig
+    from react3d_core.perception.heuristic.front_cells import _groove_cut
+
+    q = CellConfig(groove_share=0.3, groove_px=5)
+    free = np.zeros(40, bool)
+
+    def cov_with(band: slice, per_line: int) -> np.ndarray:
+        cov = np.ones((30, 40), bool)
+        cov[per_line:, band] = False
+        return cov
+
+    assert _groove_cut(cov_with(slice(18, 22), 5), 0, 10, q, free, 3) == (19, 1.0)
+    assert _groove_cut(cov_with(slice(18, 22), 10), 0, 10, q, free, 3) == (-1, 0.0)
+    assert _groove_cut(cov_with(slice(16, 22), 5), 0, 10, q, free, 3) == (-1, 0.0)
+    blocked = free.copy()
+    blocked[19] = True
+    assert _groove_cut(cov_with(slice(18, 22), 5), 0, 10, q, blocked, 3) == (-1, 0.0)
+    patchy = cov_with(slice(18, 22), 5)
+    patchy[::2] = False                                       # every line covered 15 of 30: under 0.7 x 30
+    assert _groove_cut(patchy, 0, 10, q, free, 3) == (-1, 0.0)
+    assert _groove_cut(patchy, 0, 10, CellConfig(groove_share=0.3, groove_px=5, groove_cover=0.5), free, 3) == (19, 1.0)
+    half = np.ones((30, 40), bool)
+    half[:25, 18:22] = False
+    assert _groove_cut(half, 0, 10, q, free, 3) == (19, 1.0)
+    assert _groove_cut(half, 0, 10, q, free, 1) == (-1, 0.0)
+
+
+def _bar(c0: int, r0: int, c1: int, r1: int) -> Handle:
+    rows, cols = np.mgrid[r0:r1, c0:c1]
+    return Handle((c0, r0, c1, r1), True, np.stack([cols.ravel(), rows.ravel()], 1))
+
+
+def test_a_stack_of_edge_pulls_is_cut_on_its_pitch() -> None:
+    """A 0.6 x 0.59 m white chest (150 x 148 px at 4 mm) of four 37 px drawers with no visible seam, each
+    drawer's edge pull 9 px tall just under its top edge (rows 36, 73, 110; the top drawer's lies on the
+    outline and is not found). Three bars at a 37 px pitch in a cell 148 px = 4 pitches tall: cut at
+    rows 37, 74 and 111, each bar in its own drawer, the top drawer handle-less. Without the rule
+    (``cells.pitch_tol`` 0) the cuts fall halfway between the bars (row 59 between the first two), a
+    drawer's half off. With a seam at row 60 the rule stands aside and the seam is cut."""
+    from react3d_core.config.heuristic import HeuristicConfig
+    from react3d_core.perception.heuristic.front_cells import split_cells
+    from tests.perception.heuristic.flat_orthos import flat_ortho
+
+    rng = np.random.default_rng(11)
+    img = np.full((148, 150, 3), 0.85, np.float32) + rng.normal(0, 0.003, (148, 150, 3)).astype(np.float32)
+    bars = [_bar(30, r, 120, r + 9) for r in (36, 73, 110)]
+    for b in bars:
+        img[b.box[1]:b.box[3], b.box[0]:b.box[2]] = 0.3
+    o, cov = flat_ortho(img), np.ones(img.shape[:2], bool)
+    cells = sorted(split_cells(o, cov, bars, HeuristicConfig()), key=lambda c: c.r0)
+    assert [(c.r0, c.r1) for c in cells] == [(0, 37), (38, 74), (75, 111), (112, 148)]
+    assert [len(c.handles) for c in cells] == [0, 1, 1, 1]
+    off = sorted(split_cells(o, cov, bars, HeuristicConfig(cells={"pitch_tol": 0.0})), key=lambda c: c.r0)
+    assert off[0].r1 == 59
+    seam = img.copy()
+    seam[60:62] = 0.7
+    cut = sorted(split_cells(flat_ortho(seam), cov, bars, HeuristicConfig()), key=lambda c: c.r0)
+    assert abs(cut[0].r1 - 60) <= 1
