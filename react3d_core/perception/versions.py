@@ -73,8 +73,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 40: each mask names the front it shows (Mask2D.instance), the same in every frame
 # 41: seams are read with the handles' pixels filled in along them (cells.seams_past_handles), and a straight seam
 #     just above a horizontal bar is the seam that edge pull hangs from: cut with the handle below it alone (cells.edge_pull)
-# 42: the vertical faces no plane explains vote last by normals averaged over their neighbours (planes.smooth_rings:
-#     a piece turned from a TSDF scan's voxel grid); such a plane's fronts need a handle; a band of lines the scan's
+# 42: opt-in, the vertical faces no plane explains vote last by normals averaged over their neighbours
+#     (planes.smooth_rings: a piece turned from a TSDF scan's voxel grid), and such a plane's handle-less fronts are
+#     no free-standing piece's; a band of lines the scan's
 #     surface leaves along a whole cell is a seam (cells.groove_*); a wide vertical bar may be cut through its
 #     middle, each side keeping its part (cells.bar_pairs: two doors' bars fused across the seam where they meet);
 #     a column of bars at one pitch with no seam between them is cut on the pitch grid (cells.pitch_tol)

@@ -352,7 +352,7 @@ DEFAULTS = {
     "perception.heuristic.planes.max_skew_deg": 5.0,
     "perception.heuristic.planes.normal_agree": 0.5,
     "perception.heuristic.planes.revote_rounds": 1,
-    "perception.heuristic.planes.smooth_rings": 3,
+    "perception.heuristic.planes.smooth_rings": 0,
     "perception.heuristic.planes.smooth_peak_div": 10.0,
     "perception.heuristic.planes.min_area": 0.08,
     "perception.heuristic.planes.cell": 0.04,
