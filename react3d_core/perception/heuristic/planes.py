@@ -109,14 +109,12 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
         planes += more
         found += dirs
     if cfg.smooth_rings > 0:
-        # a piece turned a few degrees from a TSDF scan's voxel grid is a staircase: its faces' normals
-        # spread over 40 degrees and no direction peaks; averaged over a few rings of neighbours they agree.
-        # Only the faces no plane explains vote so: the planes found from raw normals stay as they are
-        # (averaged everywhere, normals bend round every edge and handle and move those planes)
-        # Any direction: a chest turned 5 degrees from the wall it stands at peaks within the separation
-        # kept from the walls' own peak, whose faces are explained by then.
-        # Their averaged normals still spread by +-5 degrees, so a lower peak is enough to be voted on; the
-        # plane must still hold min_area.
+        # A small piece on a 1 cm TSDF scan has face normals spread by +-15 degrees and no direction peaks;
+        # averaged over a few rings of neighbours they agree. Only faces no plane explains vote so, so the
+        # raw-normal planes stay as they are (averaged everywhere, normals bend round edges and handles and
+        # moved them). At any direction: a chest turned 5 degrees from its wall peaks within the separation
+        # kept from the wall's peak, whose faces are explained by now. A lower peak suffices (averaged normals
+        # still spread by +-5 degrees); the plane must still hold min_area.
         more, _ = _vote(vert_s & ~_explained(planes, cen, cfg), _direction_deg(ns), area, cen, samples,
                         cfg.model_copy(update={"direction_peak_div": cfg.smooth_peak_div}), min_area, [])
         for p in more:
