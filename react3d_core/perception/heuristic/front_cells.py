@@ -665,18 +665,18 @@ def _groove_cut(cov: np.ndarray, axis: int, min_px: int, q: CellConfig, blocked:
     under ``q.groove_share`` of the cell's median line coverage, along the whole cell (in every piece
     ``piece_sides`` x ``min_px`` long), the ``min_px`` lines on each side covered at least half that level
     (median) and reaching it within ``groove_px`` / 2 lines of the band (steep walls), on a cell whose median
-    line is covered ``groove_cover`` of its length (index in the cell, 1.0); else (-1, 0.0). Why: on a 1 cm TSDF mesh the 4 mm gap between two fronts
-    is a groove 2-3 cm wide where the surface leaves the plane, unseen in the orthophoto too, so the
-    seam shows no dark line to cut at, only a gap."""
+    line is covered ``groove_cover`` of its length (index in the cell, 1.0); else (-1, 0.0).
+
+    Why: on a 1 cm TSDF mesh the 4 mm gap between two fronts is a groove 2-3 cm wide where the surface
+    leaves the plane, unseen in the orthophoto too, so the seam shows no dark line to cut at, only a gap."""
     n = cov.sum(axis).astype(float)
-    m = len(n)
+    m, length = len(n), cov.shape[axis]
     if m <= 2 * min_px + 1 or not n.any():
         return -1, 0.0
     level = float(np.median(n[n > 0]))
-    if level < q.groove_cover * cov.shape[axis]:
+    if level < q.groove_cover * length:
         return -1, 0.0  # a patchy plane: its holes line up by chance
     low = n < q.groove_share * level
-    length = cov.shape[axis]
     pieces = max(1, length // max(1, piece_sides * min_px))
     if pieces > 1:  # low in every piece where the lines beside it are covered
         for cp in np.array_split(cov, pieces, axis):
