@@ -21,9 +21,16 @@ command -v docker-compose >/dev/null || docker compose version >/dev/null 2>&1 \
 export TMPDIR="${TMPDIR:-/tmp}"
 # the fast suite (pyproject's default marker expression), then the whole-process runs (CLI subprocesses,
 # Prefect servers); both must pass. Exit status 5: the paths given hold no test of that group.
+# Each group runs under a wall-clock limit (REACT3D_TEST_GROUP_LIMIT_S, 30 min; a group takes 4-15 min on
+# 2 cores): a stuck test is ended after 10 min with its stacks (pyproject's timeout), and this catches a
+# stall outside any test, so CI always ends with a message instead of running out its time.
+limit="${REACT3D_TEST_GROUP_LIMIT_S:-1800}"
 group() {
   local rc=0
-  python3 -m pytest -n 2 --dist loadfile --durations=10 -q "$@" || rc=$?
+  timeout -k 30 "$limit" python3 -m pytest -n 2 --dist loadfile --durations=10 -q "$@" || rc=$?
+  if [ "$rc" = 124 ] || [ "$rc" = 137 ]; then
+    echo "[test] 'pytest $*' ran past ${limit} s and was stopped: a stall outside any one test"; exit 1
+  fi
   [ "$rc" = 0 ] || [ "$rc" = 5 ] || exit "$rc"
 }
 group "$@"
