@@ -297,6 +297,8 @@ class SeamConfig(StageConfig):
     step_over_dip: bool = Field(True, description="A colour step along the whole cell that is stronger than the best dark line is the cut (a shaker frame casts a dark line inside its own edge).")
     between_z: float = Field(3.0, ge=0, description="Between two handles the cut is a straight seam of at least this many noise units ...")
     between_span: float = Field(0.2, ge=0, le=1, description="... else the line with most seam evidence, when it covers more than this share; else the middle.")
+    knob_pair_gap: float = Field(0.3, ge=0, le=1, description="... except a door pair's: two knobs at one height (their rows overlap), the gap between them at most this share of the cell's width and at least one knob wide, their midpoint within knob_pair_centre of the cell's middle, with no seam between them: cut at that midpoint. The knobs of a pair of doors sit by the stiles where the doors meet, and on black or noisy TSDF fronts that seam shows no line; a wide drawer's two knobs sit at a quarter and three quarters of it (a gap of half its width). 0: off.")
+    knob_pair_centre: float = Field(0.1, ge=0, le=0.5, description="... within this share of the cell's width of its middle.")
     knob_seam: bool = Field(True, description="Two knobs side by side in a cell are cut apart only at a seam (between_z or between_span), never at the middle: a wide drawer carries two knobs and an appliance's control panel a row of them, and the middle cut halved such fronts; the two doors of a pair or two drawers in a row meet at a seam.")
 
 

@@ -79,6 +79,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     surface leaves along a whole cell is a seam (cells.groove_*); a wide vertical bar may be cut through its
 #     middle, each side keeping its part (cells.bar_pairs: two doors' bars fused across the seam where they meet);
 #     a column of bars at one pitch with no seam between them is cut on the pitch grid (cells.pitch_tol)
-HEURISTIC_VERSION = "42"
+# 43: two knobs at one height by a cell's middle, with no seam between them, are a door pair's: cut at their
+#     midpoint (seams.knob_pair_gap)
+HEURISTIC_VERSION = "43"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -417,6 +417,8 @@ DEFAULTS = {
     "perception.heuristic.seams.step_over_dip": True,
     "perception.heuristic.seams.between_z": 3.0,
     "perception.heuristic.seams.between_span": 0.2,
+    "perception.heuristic.seams.knob_pair_gap": 0.3,
+    "perception.heuristic.seams.knob_pair_centre": 0.1,
     "perception.heuristic.seams.knob_seam": True,
     "perception.heuristic.lines.enabled": False,
     "perception.heuristic.lines.weights": None,

@@ -941,6 +941,20 @@ def _pitch_split(c: Cell, g: np.ndarray, cov: np.ndarray, min_px: int, p: SeamCo
     return out
 
 
+def _door_pair_knobs(a: tuple[int, int, int, int], b: tuple[int, int, int, int], c0: int, c1: int,
+                     p: SeamConfig) -> bool:
+    """Whether knob boxes ``a`` (left) and ``b`` in a cell spanning columns [c0, c1) are a door pair's
+    (``seams.knob_pair_gap``): at one height, apart by at least a knob's width and at most that share of
+    the cell, their midpoint by the cell's middle. Why: a pair of doors has its knobs by the stiles where
+    the doors meet; a wide drawer's two knobs sit at its quarters, half its width apart."""
+    if p.knob_pair_gap <= 0 or a[1] >= b[3] or b[1] >= a[3]:
+        return False
+    w, gap = c1 - c0, b[0] - a[2]
+    mid = (a[2] + b[0]) / 2
+    return (max(a[2] - a[0], b[2] - b[0]) <= gap <= p.knob_pair_gap * w
+            and abs(mid - (c0 + c1) / 2) <= p.knob_pair_centre * w)
+
+
 def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: tuple[np.ndarray, np.ndarray],
                    p: SeamConfig, learned: LearnedLines | None = None) -> list[Cell]:
     """Split a cell between consecutive handles (side by side: at the best column between them;
@@ -951,7 +965,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
     xs = [h.center[0] for h in hs]
     ys = sorted(h.center[1] for h in hs)
     span_x, span_y = xs[-1] - xs[0], ys[-1] - ys[0]
-    if max(span_x, span_y) < min_px:
+    pair = len(hs) == 2 and hs[0].knob and hs[1].knob and _door_pair_knobs(hs[0].box, hs[1].box, c.c0, c.c1, p)
+    if max(span_x, span_y) < min_px and not pair:  # a door pair's knobs may sit closer than a front is wide
         return [c]
     if span_x >= span_y:
         gaps = np.diff(xs)
@@ -966,6 +981,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         at = _between(g[0][rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
                       None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
                       (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0), seam_only=knobs)
+        if at is None and pair:
+            at = (hs[0].box[2] + hs[1].box[0]) // 2 - c.c0
         if at is None:
             return [c]  # two knobs side by side with no seam between them: one wide drawer's or a panel's
         cut = c.c0 + at

@@ -208,6 +208,44 @@ def test_two_knobs_side_by_side_are_cut_apart_only_at_a_seam() -> None:
         assert len(got) == 2 and 72 <= min(c.c1 for c in got) <= 77
 
 
+def test_a_door_pairs_knobs_by_its_middle_are_cut_apart_with_no_seam() -> None:
+    """A black 0.8 x 0.8 m door pair (200 x 200 px at 4 mm) with no seam line, two 5 cm knobs (radius 6)
+    at one height either side of its middle, columns 88 and 112: knob boxes [82, 95) and [106, 119), a
+    13 px gap (>= one knob's 13 px width, <= 0.3 x 200 = 60 px), midpoint (95 + 106) // 2 = 100, the
+    cell's middle. With ``seams.knob_pair_gap`` it is cut there into two doors, one knob each; off, it stays
+    one front. A wide drawer's knobs at its quarters (the test above) stay one cell either way."""
+    rng = np.random.default_rng(5)
+    img = np.full((200, 200, 3), 0.08, np.float32) + rng.normal(0, 0.003, (200, 200, 3)).astype(np.float32)
+    for c in (88, 112):
+        _disc(img, 60, c, 6, 0.7)
+    o, cov = _ortho(img), np.ones(img.shape[:2], bool)
+    got = {}
+    for gap in (0.0, 0.3):
+        cfg = HeuristicConfig(handles={"knobs": True}, seams={"knob_pair_gap": gap})
+        hs = find_handles(o, cov, cfg)
+        assert len(hs) == 2 and all(h.knob for h in hs)
+        got[gap] = split_cells(o, cov, hs, cfg)
+    assert len(got[0.0]) == 1
+    assert len(got[0.3]) == 2 and min(c.c1 for c in got[0.3]) == 100
+    assert all(len(c.handles) == 1 for c in got[0.3])
+
+
+def test_door_pair_knobs_hand_computed() -> None:
+    """Knob boxes (c0, r0, c1, r1) in a cell of columns [0, 200), gap share 0.3 (60 px), centre share 0.1
+    (20 px): boxes [82, 95) and [106, 119): gap 11 >= 13? no (a knob's width is 13) -> False; [80, 93) and
+    [107, 120): gap 14 >= 13, midpoint 100 -> True; [40, 53) and [66, 79): gap 13, midpoint 59.5, 40.5 px
+    off the middle -> False; rows [60, 73) and [80, 93): not at one height -> False; gap 0 -> off."""
+    from react3d_core.config.heuristic import SeamConfig
+    from react3d_core.perception.heuristic.front_cells import _door_pair_knobs
+
+    p = SeamConfig(knob_pair_gap=0.3, knob_pair_centre=0.1)
+    assert not _door_pair_knobs((82, 60, 95, 73), (106, 60, 119, 73), 0, 200, p)
+    assert _door_pair_knobs((80, 60, 93, 73), (107, 60, 120, 73), 0, 200, p)
+    assert not _door_pair_knobs((40, 60, 53, 73), (66, 60, 79, 73), 0, 200, p)
+    assert not _door_pair_knobs((80, 60, 93, 73), (107, 80, 120, 93), 0, 200, p)
+    assert not _door_pair_knobs((80, 60, 93, 73), (107, 60, 120, 73), 0, 200, SeamConfig(knob_pair_gap=0.0))
+
+
 def _knob(c: int, r: int, side: int = 11) -> Handle:
     """A knob handle ``side`` px square centred near (c, r)."""
     box = (c - side // 2, r - side // 2, c - side // 2 + side, r - side // 2 + side)
