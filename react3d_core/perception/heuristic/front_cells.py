@@ -965,7 +965,8 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
     xs = [h.center[0] for h in hs]
     ys = sorted(h.center[1] for h in hs)
     span_x, span_y = xs[-1] - xs[0], ys[-1] - ys[0]
-    pair = len(hs) == 2 and hs[0].knob and hs[1].knob and _door_pair_knobs(hs[0].box, hs[1].box, c.c0, c.c1, p)
+    pair = (len(hs) == 2 and hs[0].knob and hs[1].knob and c.c1 - c.c0 >= 2 * min_px
+            and _door_pair_knobs(hs[0].box, hs[1].box, c.c0, c.c1, p))
     if max(span_x, span_y) < min_px and not pair:  # a door pair's knobs may sit closer than a front is wide
         return [c]
     if span_x >= span_y:
