@@ -210,9 +210,9 @@ def test_two_knobs_side_by_side_are_cut_apart_only_at_a_seam() -> None:
 
 def test_a_door_pairs_knobs_by_its_middle_are_cut_apart_with_no_seam() -> None:
     """A black 0.8 x 0.8 m door pair (200 x 200 px at 4 mm) with no seam line, two 5 cm knobs (radius 6)
-    at one height either side of its middle, columns 88 and 112: knob boxes [82, 95) and [106, 119), a
-    13 px gap (>= one knob's 13 px width, <= 0.3 x 200 = 60 px), midpoint (95 + 106) // 2 = 100, the
-    cell's middle. With ``seams.knob_pair_gap`` it is cut there into two doors, one knob each; off, it stays
+    at one height either side of its middle, columns 88 and 112, found as knob boxes [83, 94) and
+    [107, 118) (the blob's rim is opened off): a 13 px gap (>= one knob's 11 px width, <= 0.3 x 200 = 60 px),
+    midpoint (94 + 107) // 2 = 100, the cell's middle. With ``seams.knob_pair_gap`` it is cut there into two doors, one knob each; off, it stays
     one front. A wide drawer's knobs at its quarters (the test above) stay one cell either way."""
     rng = np.random.default_rng(5)
     img = np.full((200, 200, 3), 0.08, np.float32) + rng.normal(0, 0.003, (200, 200, 3)).astype(np.float32)
