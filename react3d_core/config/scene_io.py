@@ -34,6 +34,8 @@ class MissedSurfaceConfig(StageConfig):
     max_scanned: float = Field(0.5, ge=0, le=1, description="A plane whose returns already cover more than this share of its region is scanned, not missed.")
     merge_deg: float = Field(10.0, ge=0, le=90, description="Planes facing the same way within this angle may be layers of one surface.")
     merge_m: float = Field(0.15, ge=0, description="...when their overlapping regions lie within this distance (m): the one with most returns is kept.")
+    layer_deg: float = Field(30.0, ge=0, le=90, description="A plane facing within this angle of one with more returns ...")
+    layer_share: float = Field(0.8, ge=0, le=1, description="... at least this share of whose returns lie within merge_m of that plane and over its region is a layer of it (handles, stray returns) and is dropped: a line through a column of handle returns and a few stray ones is turned by several degrees, and its slab, far from the front's plane, was cut into false fronts (dark tuning front level, F1@0.5 0.559 -> 0.573; 0: off).")
     res_m: float = Field(0.015, gt=0, description="Cell size of the slab raster (m).")
     close_m: float = Field(0.07, ge=0, description="Gaps up to this (m) in a plane's region are closed.")
     seed: int = Field(0, description="RANSAC seed (deterministic).")

@@ -10,8 +10,8 @@ import trimesh
 from react3d_core.config.scene_io import MissedSurfaceConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.raster import Rasterizer
-from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, hole_share, island_vertices, merge_layers,
-                                                  missed_planes, plane_cells, seen_planes, slab_mesh)
+from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, hole_share, is_layer_of, island_vertices,
+                                                  merge_layers, missed_planes, plane_cells, seen_planes, slab_mesh)
 
 W, H = 160, 120
 K = np.array([[120.0, 0, 79.5], [0, 120.0, 59.5], [0, 0, 1]])
@@ -170,3 +170,32 @@ def test_hole_share_gates_scans_without_missed_surfaces(corner):
     assert hole_share([HoleView(K, np.eye(4), one, one), HoleView(K, np.eye(4), one, np.array([[0, 1], [1, 1]], np.float32))]) == 0.125
     assert hole_share([HoleView(K, np.eye(4), np.array([[0, 1], [0, 1]], np.float32), None)]) == 0.5  # no depth: scan holes
     assert hole_share(views) > MissedSurfaceConfig().min_hole_share  # the black cabinet fills much of the views
+
+
+def _returns(rng: np.random.Generator) -> np.ndarray:
+    """A black base unit's returns on its front y = 1.4 (x 0..0.9, z 0.1..0.8: a few patches), a column of handle
+    returns 3 cm in front of it, and two stray ones 12 cm out at its far end."""
+    face = np.stack([rng.uniform(0.0, 0.9, 60), np.full(60, 1.4) + rng.normal(0, 0.003, 60), rng.uniform(0.1, 0.8, 60)], 1)
+    handles = np.stack([rng.uniform(0.40, 0.47, 40), np.full(40, 1.37) + rng.normal(0, 0.003, 40), rng.uniform(0.2, 0.7, 40)], 1)
+    stray = np.array([[0.88, 1.28, 0.5], [0.89, 1.28, 0.6]])
+    return np.concatenate([face, handles, stray])
+
+
+def test_a_handle_column_is_a_layer_of_its_front():
+    cfg = MissedSurfaceConfig(res_m=0.05)
+    front = _plane(1.4, 0.0, 0.9, 0.1, 0.8, n_returns=60)
+    P = _returns(np.random.default_rng(2))
+    t = np.radians(11.6)
+    turned = MissedPlane(point=np.array([0.43, 1.37, 0.0]), normal=np.array([-np.sin(t), -np.cos(t), 0.0]),
+                         u=np.array([-np.cos(t), np.sin(t), 0.0]), u0=-0.5, v_top=0.8, res=0.05, cells=np.ones((14, 20), bool),
+                         n_returns=42, returns=P[60:])
+    assert is_layer_of(turned, front, cfg)  # 40 + 2 returns, all within 15 cm of the front and over it
+    out = MissedPlane(turned.point, turned.normal, turned.u, turned.u0, turned.v_top, turned.res, turned.cells, 42,
+                      P[60:] - [0, 0.3, 0])  # the same returns 30 cm out: another surface
+    assert not is_layer_of(out, front, cfg)
+    side = MissedPlane(turned.point, np.array([-1.0, 0.0, 0.0]), turned.u, turned.u0, turned.v_top, turned.res,
+                       turned.cells, 42, P[60:])  # facing at right angles: a side, not a layer
+    assert not is_layer_of(side, front, cfg)
+    kept = merge_layers([turned, front], cfg)
+    assert len(kept) == 1 and kept[0].n_returns == 102 and np.isclose(kept[0].point[1], 1.4)
+    assert not is_layer_of(turned, front, cfg.model_copy(update={"layer_share": 0.0}))  # off
