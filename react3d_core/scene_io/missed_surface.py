@@ -17,7 +17,7 @@ fronts on the slab as on any other plane.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import cv2
@@ -402,7 +402,7 @@ def merge_layers(planes: Sequence[MissedPlane], cfg: MissedSurfaceConfig) -> lis
         p = planes[i]
         layer = next((k for k, q in enumerate(kept) if is_layer_of(p, q, cfg)), None)
         if layer is not None:
-            kept[layer].n_returns += p.n_returns
+            kept[layer] = replace(kept[layer], n_returns=kept[layer].n_returns + p.n_returns)  # the inputs stay as they are
             continue
         corners = _region_points(p)
         host = None

@@ -198,4 +198,5 @@ def test_a_handle_column_is_a_layer_of_its_front():
     assert not is_layer_of(side, front, cfg)
     kept = merge_layers([turned, front], cfg)
     assert len(kept) == 1 and kept[0].n_returns == 102 and np.isclose(kept[0].point[1], 1.4)
+    assert front.n_returns == 60  # the input planes are not changed
     assert not is_layer_of(turned, front, cfg.model_copy(update={"layer_share": 0.0}))  # off
