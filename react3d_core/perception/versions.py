@@ -81,6 +81,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     a column of bars at one pitch with no seam between them is cut on the pitch grid (cells.pitch_tol)
 # 43: two knobs at one height by a cell's middle, with no seam between them, are a door pair's: cut at their
 #     midpoint (seams.knob_pair_gap)
-HEURISTIC_VERSION = "43"
+# 44: colour beside hidden scan surface is no handle again (handles.hidden_side), when the hidden surface also
+#     reaches hidden_depth from it: what an occluder hides, not the strip a handle hides from oblique views
+HEURISTIC_VERSION = "44"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -210,7 +210,8 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
             continue
         if p.hidden_side > 0 and not bars_only:
             hidden = coverage.astype(bool) & ~valid if hidden is None else hidden
-            if _at_hidden_edge(hidden, protrusion, lab[y:y + h, x:x + w] == j, (x, y, w, h), pad, p):
+            depth = max(pad, int(round(p.hidden_depth / o.res)))
+            if _at_hidden_edge(hidden, protrusion, lab[y:y + h, x:x + w] == j, (x, y, w, h), pad, p, depth):
                 continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
@@ -265,21 +266,30 @@ def knobs_in_patterns(handles: list[Handle], tol_px: float, size_ratio: float, r
 
 
 def _at_hidden_edge(hidden: np.ndarray, protrusion: np.ndarray | None, mine: np.ndarray,
-                    box: tuple[int, int, int, int], pad: int, p: HandleConfig) -> bool:
+                    box: tuple[int, int, int, int], pad: int, p: HandleConfig, depth_px: int = 0) -> bool:
     """Whether a blob (``mine``: its pixels in its ``box`` x, y, w, h) is colour only (under ``p.bar_share`` of it
     on ``protrusion``) and has, along a long side, ``p.hidden_side`` or more of the ``pad``-wide band ``hidden``:
-    on the plane's surface (its coverage) but seen by no view.
+    on the plane's surface (its coverage) but seen by no view; and as much of the ``pad``-wide band on that
+    side that ends ``depth_px`` from the blob (``handles.hidden_depth``; 0 or ``pad``: the first band only).
 
     Why: there the plane is hidden from every view by something in front of it (a chair, a box, the next
     piece), and the colour along that edge is the edge of whatever hides it, or the plane's own edge lit or
     shaded: the sides and backs of pieces standing free became doors at such blobs (free-standing tuning,
     laser scans: a sideboard's back and side, a box's side, a turned piece's back). A handle's scanning
     shadow is no such band: the scan lacks the surface there, so it is not ``coverage``; and a handle the
-    scan holds stands out of the plane."""
+    scan holds stands out of the plane. What a real handle hides beside it from oblique views, or what a
+    worktop's overhang hides above a top handle, is a strip a few cm wide; an occluder hides more: on
+    RedKitchen a chair hid a 25 cm patch of a door, whose edge became a second handle and cut the door in
+    two, while the left run's handles have up to about 5 cm of unseen surface beside them."""
     x, y, w, h = box
     if protrusion is not None and float(protrusion[y:y + h, x:x + w][mine].mean()) >= p.bar_share:
         return False
-    return max(_side_cover(hidden, box, pad)) >= p.hidden_side
+    near = _side_cover(hidden, box, pad)
+    g = max(0, depth_px - pad)
+    if g == 0:
+        return max(near) >= p.hidden_side
+    far = _side_cover(hidden, box, pad, g)
+    return any(a >= p.hidden_side and b >= p.hidden_side for a, b in zip(near, far))
 
 
 def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, share: float,
@@ -331,16 +341,22 @@ def _long_seams(o: Orthophoto, cfg: HeuristicConfig, length_px: int) -> np.ndarr
     return (lv | lh).astype(bool)
 
 
-def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int) -> tuple[float, float]:
-    """Share of the ``pad``-wide bands along both long sides of ``box`` (x, y, w, h) that ``ref`` covers;
-    band pixels beyond the grid count as uncovered (the plane ends there)."""
+def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int, gap: int = 0) -> tuple[float, float]:
+    """Share of the ``pad``-wide bands along both long sides of ``box`` (x, y, w, h), ``gap`` px off it, that
+    ``ref`` covers; band pixels beyond the grid count as uncovered (the plane ends there)."""
     x, y, w, h = box
     H, W = ref.shape
+
+    def band(a: int, b: int, n: int) -> slice:
+        return slice(min(max(a, 0), n), min(max(b, 0), n))
+
     if w >= h:  # horizontal: above and below
-        bands = [ref[max(0, y - pad):y, x:x + w], ref[y + h:min(H, y + h + pad), x:x + w]]
+        bands = [ref[band(y - gap - pad, y - gap, H), band(x, x + w, W)],
+                 ref[band(y + h + gap, y + h + gap + pad, H), band(x, x + w, W)]]
         full = pad * w
     else:  # vertical: left and right
-        bands = [ref[y:y + h, max(0, x - pad):x], ref[y:y + h, x + w:min(W, x + w + pad)]]
+        bands = [ref[band(y, y + h, H), band(x - gap - pad, x - gap, W)],
+                 ref[band(y, y + h, H), band(x + w + gap, x + w + gap + pad, W)]]
         full = pad * h
     return float(bands[0].sum()) / full, float(bands[1].sum()) / full
 

@@ -1,4 +1,5 @@
-"""Colour at the edge of what the views see is no handle (front_cells._at_hidden_edge, handles.hidden_side)."""
+"""Colour at the edge of what the views see is no handle (front_cells._at_hidden_edge, handles.hidden_side and
+hidden_depth)."""
 
 from __future__ import annotations
 
@@ -22,12 +23,14 @@ def _panel() -> np.ndarray:
 
 def test_colour_along_a_hidden_band_is_no_handle() -> None:
     """The panel's surface is all in the scan (coverage everywhere), but no view sees it below the blob
-    (rows 76 on: a chair in front of a sideboard's side). Off (the default), the blob is a handle; with
-    hidden_side 0.5 its lower side's 2 cm band is hidden surface and it goes. Seen all round, it stays."""
+    (rows 76 on: a chair in front of a sideboard's side). With the rule off the blob is a handle; with the
+    defaults (hidden_side 0.5) its lower side's 2 cm band is hidden surface and it goes. Seen all round, it
+    stays."""
     o = flat_ortho(_panel())
     o.n_views[76:, :] = 0
     cov = np.ones((_H, _W), bool)
-    off, on = HeuristicConfig(), HeuristicConfig(handles={"hidden_side": 0.5})
+    off, on = HeuristicConfig(handles={"hidden_side": 0.0}), HeuristicConfig()
+    assert on.handles.hidden_side == 0.5
     assert len(find_handles(o, cov, off)) == 1
     assert find_handles(o, cov, on) == []
     assert len(find_handles(flat_ortho(_panel()), cov, on)) == 1
@@ -52,3 +55,17 @@ def test_a_bar_the_scan_holds_stays_beside_a_hidden_band() -> None:
     bars = np.zeros((_H, _W), bool)
     bars[_BAR] = True
     assert len(find_handles(o, cov, HeuristicConfig(handles={"hidden_side": 0.5}), protrusion=bars)) == 1
+
+
+def test_a_narrow_hidden_strip_is_what_a_handle_hides() -> None:
+    """At 4 mm the side band is 5 px (2 cm) and hidden_depth 0.06 m is 15 px: the band 10-15 px below the
+    blob (rows 86-90) must be hidden too. Unseen rows 76-85 (4 cm: what a handle or a worktop's overhang
+    hides from oblique views): the first band is all hidden, the far one not, so the blob stays a handle;
+    with hidden_depth 0 (the first band only) it goes. Unseen down to row 87, the far band is 2 / 5 hidden and the
+    blob stays; down to row 88, 3 / 5 (0.6) and it goes."""
+    cov = np.ones((_H, _W), bool)
+    for r1, depth, kept in ((86, 0.06, True), (86, 0.0, False), (88, 0.06, True), (89, 0.06, False), (91, 0.0, False)):
+        o = flat_ortho(_panel())
+        o.n_views[76:r1, :] = 0
+        got = find_handles(o, cov, HeuristicConfig(handles={"hidden_depth": depth}))
+        assert (len(got) == 1) == kept, (r1, depth)
