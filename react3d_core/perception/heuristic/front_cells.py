@@ -285,10 +285,8 @@ def _at_hidden_edge(hidden: np.ndarray, protrusion: np.ndarray | None, mine: np.
     if protrusion is not None and float(protrusion[y:y + h, x:x + w][mine].mean()) >= p.bar_share:
         return False
     near = _side_cover(hidden, box, pad)
-    g = max(0, depth_px - pad)
-    if g == 0:
-        return max(near) >= p.hidden_side
-    far = _side_cover(hidden, box, pad, g)
+    g = depth_px - pad
+    far = _side_cover(hidden, box, pad, g) if g > 0 else near
     return any(a >= p.hidden_side and b >= p.hidden_side for a, b in zip(near, far))
 
 
