@@ -24,6 +24,7 @@ class MissedSurfaceConfig(StageConfig):
     min_depth_m: float = Field(0.06, gt=0, description="A missed volume holds at least min_area x this (m³): thinner ones are noise.")
     min_returns: int = Field(15, ge=3, description="A missed vertical plane is fixed by at least this many scan vertices on it (its sparse returns).")
     max_island_m2: float = Field(0.1, gt=0, description="Returns are vertices of scan pieces under this area (m²): a missed front keeps islands, walls and floors are large.")
+    flat_island_nz: float = Field(0.8, ge=0, le=1, description="Islands facing up or down (the area-weighted mean of their faces' normals has a vertical part of at least this) are no returns of a vertical front: a dark worktop's or shelf's returns lie all over it, and a vertical plane drawn diagonally through them gathered more returns than the fronts below it (dark tuning 350: a base run's slab turned 11 degrees through the cabinets). 1: off.")
     min_spread_m: float = Field(0.1, gt=0, description="A plane's returns spread over at least this (m, 10th-90th percentile) across and up.")
     plane_tol_m: float = Field(0.015, gt=0, description="A return lies on a plane within this distance (m).")
     ransac_iters: int = Field(400, ge=1, description="RANSAC hypotheses per vertical plane.")

@@ -30,7 +30,7 @@ from ..data.mesh import TriMesh
 from ..raster import Rasterizer
 
 _UP = np.array([0.0, 0.0, 1.0])
-COMPLETION_VERSION = "2"  # what a completed mesh in the cache was made by
+COMPLETION_VERSION = "3"  # what a completed mesh in the cache was made by
 
 
 @dataclass
@@ -137,9 +137,12 @@ def carve(views: Sequence[HoleView], lo: np.ndarray, shape: tuple[int, int, int]
     return out.reshape(shape)
 
 
-def island_vertices(mesh: TriMesh, max_area: float) -> np.ndarray:
+def island_vertices(mesh: TriMesh, max_area: float, flat_nz: float = 1.0) -> np.ndarray:
     """Vertices of mesh pieces (connected through shared vertices) under ``max_area`` m²: a missed surface keeps
-    only islands of returns, while the walls and floor around it are large connected surfaces."""
+    only islands of returns, while the walls and floor around it are large connected surfaces. With
+    ``flat_nz`` < 1, pieces facing up or down (area-weighted mean normal with a vertical part of at least
+    ``flat_nz``) are left out too: they are returns of a worktop or a shelf, not of a front, and a vertical
+    plane drawn across a sheet of them gathers returns wherever it runs."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -148,8 +151,13 @@ def island_vertices(mesh: TriMesh, max_area: float) -> np.ndarray:
     rows = np.concatenate([f[:, 0], f[:, 1]])
     cols = np.concatenate([f[:, 1], f[:, 2]])
     _, lab = connected_components(coo_matrix((np.ones(len(rows), np.int8), (rows, cols)), shape=(n, n)), directed=False)
-    area = np.bincount(lab[f[:, 0]], weights=mesh.face_areas, minlength=lab.max() + 1)
-    return area[lab] < max_area
+    piece = lab[f[:, 0]]
+    area = np.bincount(piece, weights=mesh.face_areas, minlength=lab.max() + 1)
+    keep = area < max_area
+    if flat_nz < 1.0:
+        nz = np.bincount(piece, weights=mesh.face_areas * mesh.face_normals[:, 2], minlength=lab.max() + 1)
+        keep &= np.abs(nz) < flat_nz * np.maximum(area, 1e-12)
+    return keep[lab]
 
 
 def fit_vertical_planes(pts: np.ndarray, cameras: np.ndarray, cfg: MissedSurfaceConfig, rng: np.random.Generator,
@@ -349,7 +357,7 @@ def missed_planes(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, cf
     vi = np.floor((mesh.vertices - lo) / cfg.voxel_m).astype(int)
     ok = np.all((vi >= 0) & (vi < np.array(shape)), axis=1)
     ok[ok] = vol[vi[ok, 0], vi[ok, 1], vi[ok, 2]]
-    ok &= island_vertices(mesh, cfg.max_island_m2)
+    ok &= island_vertices(mesh, cfg.max_island_m2, cfg.flat_island_nz)
     P = mesh.vertices[ok]
     cams = np.array([-v.w2c[:3, :3].T @ v.w2c[:3, 3] for v in views])
     rng = np.random.default_rng(cfg.seed)

@@ -200,3 +200,52 @@ def test_a_handle_column_is_a_layer_of_its_front():
     assert len(kept) == 1 and kept[0].n_returns == 102 and np.isclose(kept[0].point[1], 1.4)
     assert front.n_returns == 60  # the input planes are not changed
     assert not is_layer_of(turned, front, cfg.model_copy(update={"layer_share": 0.0}))  # off
+
+
+def _chip(centre, normal, size: float = 0.04) -> trimesh.Trimesh:
+    """A square patch of scan surface (two triangles) facing ``normal``: one island of returns."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    a = np.cross(n, [1.0, 0, 0] if abs(n[0]) < 0.9 else [0, 1.0, 0])
+    a /= np.linalg.norm(a)
+    b = np.cross(n, a)
+    c = np.asarray(centre, float)
+    v = np.array([c + size / 2 * (sa * a + sb * b) for sa, sb in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+    f = np.array([[0, 1, 2], [0, 2, 3]])
+    if np.dot(np.cross(v[1] - v[0], v[2] - v[0]), n) < 0:
+        f = f[:, ::-1]
+    return trimesh.Trimesh(v, f, process=False)
+
+
+def test_islands_facing_up_or_down_are_no_returns():
+    # the area-weighted normal's vertical part: 1 for a worktop chip, 0 for a front's, cos 45 deg = 0.707 for
+    # one tilted half-way, 0 for a closed handle box (its faces' normals cancel)
+    chips = [_chip([0, 0, 0.9], [0, 0, 1]), _chip([1, 0, 0.9], [0, 0, -1]), _chip([2, 0, 0.5], [0, -1, 0]),
+             _chip([3, 0, 0.5], [0, -1, 1])]
+    handle = _box([4, 0, 0.5], [4.12, 0.02, 0.52])
+    parts = chips + [handle]
+    m = trimesh.util.concatenate(parts)
+    owner = np.repeat(np.arange(len(parts)), [len(p.vertices) for p in parts])
+    tm = TriMesh(m.vertices, m.faces)
+    kept = island_vertices(tm, 0.1, flat_nz=0.8)
+    assert [bool(kept[owner == k].all()) for k in range(len(parts))] == [False, False, True, True, True]
+    assert not any(kept[owner == k].any() for k in (0, 1))
+    assert island_vertices(tm, 0.1, flat_nz=0.7)[owner == 3].sum() == 0  # 0.707 >= 0.7: facing up enough
+    assert island_vertices(tm, 0.1).all()  # flat_nz 1: off, every small piece is a return
+
+
+def test_a_worktop_sheet_of_returns_does_not_turn_the_front_plane():
+    # a black base run's front at y = 0.57 returns a sparse column of chips; its dark worktop (z 0.9, y 0..0.6)
+    # returns a dense sheet of chips all over it: planes are fitted to the returns left after the islands test
+    rng = np.random.default_rng(3)
+    front = [_chip([x, 0.57, z], [0, 1, 0], 0.03) for x, z in zip(rng.uniform(1.6, 3.6, 40), rng.uniform(0.1, 0.85, 40))]
+    sheet = [_chip([x, y, 0.9], [0, 0, 1], 0.03) for x, y in zip(rng.uniform(0.5, 3.6, 400), rng.uniform(0.0, 0.6, 400))]
+    m = trimesh.util.concatenate(front + sheet)
+    tm = TriMesh(m.vertices, m.faces)
+    cams = np.array([[2.5, 3.0, 1.5], [1.5, 3.0, 1.5]])
+    cfg = MissedSurfaceConfig()
+    from react3d_core.scene_io.missed_surface import fit_vertical_planes
+    pts = tm.vertices[island_vertices(tm, cfg.max_island_m2, cfg.flat_island_nz)]
+    assert len(pts) == 4 * len(front)
+    planes = fit_vertical_planes(pts, cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m)
+    point, normal, _ = planes[0]
+    assert normal[1] > 0.999 and abs(point[1] - 0.57) < 0.005  # the front, facing the cameras
