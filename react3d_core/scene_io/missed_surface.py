@@ -137,12 +137,28 @@ def carve(views: Sequence[HoleView], lo: np.ndarray, shape: tuple[int, int, int]
     return out.reshape(shape)
 
 
-def island_vertices(mesh: TriMesh, max_area: float, flat_nz: float = 1.0) -> np.ndarray:
+def island_vertices(mesh: TriMesh, max_area: float) -> np.ndarray:
     """Vertices of mesh pieces (connected through shared vertices) under ``max_area`` m²: a missed surface keeps
-    only islands of returns, while the walls and floor around it are large connected surfaces. With
-    ``flat_nz`` < 1, pieces facing up or down (area-weighted mean normal with a vertical part of at least
-    ``flat_nz``) are left out too: they are returns of a worktop or a shelf, not of a front, and a vertical
-    plane drawn across a sheet of them gathers returns wherever it runs."""
+    only islands of returns, while the walls and floor around it are large connected surfaces."""
+    lab = _pieces(mesh)
+    area = np.bincount(lab[mesh.faces[:, 0]], weights=mesh.face_areas, minlength=lab.max() + 1)
+    return area[lab] < max_area
+
+
+def flat_vertices(mesh: TriMesh, min_nz: float) -> np.ndarray:
+    """Vertices of mesh pieces facing up or down: the area-weighted mean of their faces' normals has a vertical
+    part of at least ``min_nz`` (1: none). Such a piece is a worktop's or a shelf's return, not a front's."""
+    if min_nz >= 1.0:
+        return np.zeros(mesh.n_vertices, bool)
+    lab = _pieces(mesh)
+    piece = lab[mesh.faces[:, 0]]
+    area = np.bincount(piece, weights=mesh.face_areas, minlength=lab.max() + 1)
+    nz = np.bincount(piece, weights=mesh.face_areas * mesh.face_normals[:, 2], minlength=lab.max() + 1)
+    return (np.abs(nz) >= min_nz * np.maximum(area, 1e-12))[lab]
+
+
+def _pieces(mesh: TriMesh) -> np.ndarray:
+    """Connected piece label of every vertex (connected through shared vertices)."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -150,14 +166,7 @@ def island_vertices(mesh: TriMesh, max_area: float, flat_nz: float = 1.0) -> np.
     n = mesh.n_vertices
     rows = np.concatenate([f[:, 0], f[:, 1]])
     cols = np.concatenate([f[:, 1], f[:, 2]])
-    _, lab = connected_components(coo_matrix((np.ones(len(rows), np.int8), (rows, cols)), shape=(n, n)), directed=False)
-    piece = lab[f[:, 0]]
-    area = np.bincount(piece, weights=mesh.face_areas, minlength=lab.max() + 1)
-    keep = area < max_area
-    if flat_nz < 1.0:
-        nz = np.bincount(piece, weights=mesh.face_areas * mesh.face_normals[:, 2], minlength=lab.max() + 1)
-        keep &= np.abs(nz) < flat_nz * np.maximum(area, 1e-12)
-    return keep[lab]
+    return connected_components(coo_matrix((np.ones(len(rows), np.int8), (rows, cols)), shape=(n, n)), directed=False)[1]
 
 
 def fit_vertical_planes(pts: np.ndarray, cameras: np.ndarray, cfg: MissedSurfaceConfig, rng: np.random.Generator,
@@ -174,10 +183,14 @@ def fit_vertical_planes(pts: np.ndarray, cameras: np.ndarray, cfg: MissedSurface
     cam_c = cameras.mean(0)
     while len(todo) >= need:
         P = pts[todo]
-        k = min(cfg.ransac_neighbours, len(P))
         a = rng.integers(0, len(P), cfg.ransac_iters)
-        _, nb_idx = cKDTree(P).query(P[a], k=k)
-        b = np.asarray(nb_idx).reshape(len(a), -1)[np.arange(len(a)), rng.integers(0, k, len(a))]
+        if cfg.pair_reach_m > 0:  # a partner anywhere within reach across: columns of returns are no hypotheses
+            reach = cKDTree(P[:, :2]).query_ball_point(P[a, :2], cfg.pair_reach_m)
+            b = np.array([r[int(x * len(r))] for r, x in zip(reach, rng.random(len(a)))], np.int64)
+        else:
+            k = min(cfg.ransac_neighbours, len(P))
+            _, nb_idx = cKDTree(P).query(P[a], k=k)
+            b = np.asarray(nb_idx).reshape(len(a), -1)[np.arange(len(a)), rng.integers(0, k, len(a))]
         d = (P[b] - P[a]) * np.array([1.0, 1.0, 0.0])
         n = np.cross(d, _UP)
         nn = np.linalg.norm(n, axis=1)
@@ -357,7 +370,7 @@ def missed_planes(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, cf
     vi = np.floor((mesh.vertices - lo) / cfg.voxel_m).astype(int)
     ok = np.all((vi >= 0) & (vi < np.array(shape)), axis=1)
     ok[ok] = vol[vi[ok, 0], vi[ok, 1], vi[ok, 2]]
-    ok &= island_vertices(mesh, cfg.max_island_m2, cfg.flat_island_nz)
+    ok &= island_vertices(mesh, cfg.max_island_m2) & ~flat_vertices(mesh, cfg.flat_island_nz)
     P = mesh.vertices[ok]
     cams = np.array([-v.w2c[:3, :3].T @ v.w2c[:3, 3] for v in views])
     rng = np.random.default_rng(cfg.seed)

@@ -10,8 +10,9 @@ import trimesh
 from react3d_core.config.scene_io import MissedSurfaceConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.raster import Rasterizer
-from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, hole_share, is_layer_of, island_vertices,
-                                                  merge_layers, missed_planes, plane_cells, seen_planes, slab_mesh)
+from react3d_core.scene_io.missed_surface import (HoleView, MissedPlane, carve, fit_vertical_planes, flat_vertices, hole_share,
+                                                  is_layer_of, island_vertices, merge_layers, missed_planes, plane_cells,
+                                                  seen_planes, slab_mesh)
 
 W, H = 160, 120
 K = np.array([[120.0, 0, 79.5], [0, 120.0, 59.5], [0, 0, 1]])
@@ -216,9 +217,9 @@ def _chip(centre, normal, size: float = 0.04) -> trimesh.Trimesh:
     return trimesh.Trimesh(v, f, process=False)
 
 
-def test_islands_facing_up_or_down_are_no_returns():
-    # the area-weighted normal's vertical part: 1 for a worktop chip, 0 for a front's, cos 45 deg = 0.707 for
-    # one tilted half-way, 0 for a closed handle box (its faces' normals cancel)
+def test_islands_facing_up_or_down_are_flat():
+    # the area-weighted normal's vertical part: 1 for a worktop chip, 1 for a cabinet bottom's (facing down), 0 for
+    # a front's, cos 45 deg = 0.707 for one tilted half-way, 0 for a closed handle box (its faces' normals cancel)
     chips = [_chip([0, 0, 0.9], [0, 0, 1]), _chip([1, 0, 0.9], [0, 0, -1]), _chip([2, 0, 0.5], [0, -1, 0]),
              _chip([3, 0, 0.5], [0, -1, 1])]
     handle = _box([4, 0, 0.5], [4.12, 0.02, 0.52])
@@ -226,26 +227,45 @@ def test_islands_facing_up_or_down_are_no_returns():
     m = trimesh.util.concatenate(parts)
     owner = np.repeat(np.arange(len(parts)), [len(p.vertices) for p in parts])
     tm = TriMesh(m.vertices, m.faces)
-    kept = island_vertices(tm, 0.1, flat_nz=0.8)
-    assert [bool(kept[owner == k].all()) for k in range(len(parts))] == [False, False, True, True, True]
-    assert not any(kept[owner == k].any() for k in (0, 1))
-    assert island_vertices(tm, 0.1, flat_nz=0.7)[owner == 3].sum() == 0  # 0.707 >= 0.7: facing up enough
-    assert island_vertices(tm, 0.1).all()  # flat_nz 1: off, every small piece is a return
+    flat = flat_vertices(tm, 0.8)
+    assert [bool(flat[owner == k].all()) for k in range(len(parts))] == [True, True, False, False, False]
+    assert [bool(flat[owner == k].any()) for k in range(len(parts))] == [True, True, False, False, False]
+    assert flat_vertices(tm, 0.7)[owner == 3].all()  # 0.707 >= 0.7: facing up enough
+    assert not flat_vertices(tm, 1.0).any()  # 1: off
+    assert island_vertices(tm, 0.1).all()  # every piece is small: all are returns, flat or not
 
 
-def test_a_worktop_sheet_of_returns_does_not_turn_the_front_plane():
-    # a black base run's front at y = 0.57 returns a sparse column of chips; its dark worktop (z 0.9, y 0..0.6)
-    # returns a dense sheet of chips all over it: planes are fitted to the returns left after the islands test
+def test_a_worktop_sheet_leaves_only_the_front_returns():
+    # a black base run's front at y = 0.57 returns a sparse column of chips under a dark worktop (z 0.9, y 0..0.6)
+    # that returns a dense sheet of chips all over it: the planes are fitted to the front's chips alone
     rng = np.random.default_rng(3)
-    front = [_chip([x, 0.57, z], [0, 1, 0], 0.03) for x, z in zip(rng.uniform(1.6, 3.6, 40), rng.uniform(0.1, 0.85, 40))]
+    front = [_chip([x, 0.57, z], [0, 1, 0], 0.03) for x, z in zip(rng.uniform(1.9, 2.2, 25), rng.uniform(0.1, 0.85, 25))]
     sheet = [_chip([x, y, 0.9], [0, 0, 1], 0.03) for x, y in zip(rng.uniform(0.5, 3.6, 400), rng.uniform(0.0, 0.6, 400))]
     m = trimesh.util.concatenate(front + sheet)
     tm = TriMesh(m.vertices, m.faces)
     cams = np.array([[2.5, 3.0, 1.5], [1.5, 3.0, 1.5]])
     cfg = MissedSurfaceConfig()
-    from react3d_core.scene_io.missed_surface import fit_vertical_planes
-    pts = tm.vertices[island_vertices(tm, cfg.max_island_m2, cfg.flat_island_nz)]
-    assert len(pts) == 4 * len(front)
-    planes = fit_vertical_planes(pts, cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m)
-    point, normal, _ = planes[0]
-    assert normal[1] > 0.999 and abs(point[1] - 0.57) < 0.005  # the front, facing the cameras
+    returns = island_vertices(tm, cfg.max_island_m2) & ~flat_vertices(tm, cfg.flat_island_nz)
+    assert returns.sum() == 4 * len(front) and not returns[4 * len(front):].any()  # the front's chips come first
+    planes = fit_vertical_planes(tm.vertices[returns], cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns,
+                                 cfg.plane_tol_m)
+    point, normal, inl = planes[0]
+    assert normal[1] > 0.999 and abs(point[1] - 0.57) < 0.005 and len(inl) == 4 * len(front)
+
+
+def test_columns_of_returns_make_one_plane():
+    # a black wall run returns only its door edges: three dense columns 2 cm wide and 0.6 m tall, 0.6 m apart, on
+    # y = 4.09. Paired with their nearest returns, the hypotheses stay inside one column (under a voxel across,
+    # or turned any way) and no plane is found; paired with any return within 0.6 m across, the run is one plane
+    rng = np.random.default_rng(0)
+    P = np.concatenate([np.stack([x + rng.uniform(-0.01, 0.01, 200), 4.09 + rng.normal(0, 0.004, 200),
+                                  rng.uniform(1.5, 2.1, 200)], 1) for x in (2.4, 3.0, 3.6)])
+    cams = np.array([[3.0, 1.0, 1.5]])
+    cfg = MissedSurfaceConfig()
+    assert cfg.pair_reach_m == 0.6
+    planes = fit_vertical_planes(P, cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m)
+    assert len(planes) == 1
+    point, normal, inl = planes[0]
+    assert normal[1] < -0.9999 and abs(point[1] - 4.09) < 0.003 and len(inl) >= 595
+    nearest = cfg.model_copy(update={"pair_reach_m": 0.0})
+    assert fit_vertical_planes(P, cams, nearest, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m) == []
