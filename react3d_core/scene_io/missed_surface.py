@@ -30,7 +30,7 @@ from ..data.mesh import TriMesh
 from ..raster import Rasterizer
 
 _UP = np.array([0.0, 0.0, 1.0])
-COMPLETION_VERSION = "3"  # what a completed mesh in the cache was made by
+COMPLETION_VERSION = "2"  # what a completed mesh in the cache was made by
 
 
 @dataclass

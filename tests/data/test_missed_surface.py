@@ -244,7 +244,7 @@ def test_a_worktop_sheet_leaves_only_the_front_returns():
     m = trimesh.util.concatenate(front + sheet)
     tm = TriMesh(m.vertices, m.faces)
     cams = np.array([[2.5, 3.0, 1.5], [1.5, 3.0, 1.5]])
-    cfg = MissedSurfaceConfig()
+    cfg = MissedSurfaceConfig(flat_island_nz=0.8)
     returns = island_vertices(tm, cfg.max_island_m2) & ~flat_vertices(tm, cfg.flat_island_nz)
     assert returns.sum() == 4 * len(front) and not returns[4 * len(front):].any()  # the front's chips come first
     planes = fit_vertical_planes(tm.vertices[returns], cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns,
@@ -255,17 +255,18 @@ def test_a_worktop_sheet_leaves_only_the_front_returns():
 
 def test_columns_of_returns_make_one_plane():
     # a black wall run returns only its door edges: three dense columns 2 cm wide and 0.6 m tall, 0.6 m apart, on
-    # y = 4.09. Paired with their nearest returns, the hypotheses stay inside one column (under a voxel across,
-    # or turned any way) and no plane is found; paired with any return within 0.6 m across, the run is one plane
+    # y = 4.09. Paired with their nearest returns (the default), the hypotheses stay inside one column (under a
+    # voxel across, or turned any way) and no plane is found; paired with any return within 0.6 m across (opt-in
+    # pair_reach_m), the run is one plane
     rng = np.random.default_rng(0)
     P = np.concatenate([np.stack([x + rng.uniform(-0.01, 0.01, 200), 4.09 + rng.normal(0, 0.004, 200),
                                   rng.uniform(1.5, 2.1, 200)], 1) for x in (2.4, 3.0, 3.6)])
     cams = np.array([[3.0, 1.0, 1.5]])
-    cfg = MissedSurfaceConfig()
-    assert cfg.pair_reach_m == 0.6
+    cfg = MissedSurfaceConfig(pair_reach_m=0.6)
     planes = fit_vertical_planes(P, cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m)
     assert len(planes) == 1
     point, normal, inl = planes[0]
     assert normal[1] < -0.9999 and abs(point[1] - 4.09) < 0.003 and len(inl) >= 595
-    nearest = cfg.model_copy(update={"pair_reach_m": 0.0})
+    nearest = MissedSurfaceConfig()  # the default: nearest returns
+    assert nearest.pair_reach_m == 0.0
     assert fit_vertical_planes(P, cams, nearest, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m) == []
