@@ -137,20 +137,22 @@ def carve(views: Sequence[HoleView], lo: np.ndarray, shape: tuple[int, int, int]
     return out.reshape(shape)
 
 
-def island_vertices(mesh: TriMesh, max_area: float) -> np.ndarray:
+def island_vertices(mesh: TriMesh, max_area: float, pieces: np.ndarray | None = None) -> np.ndarray:
     """Vertices of mesh pieces (connected through shared vertices) under ``max_area`` m²: a missed surface keeps
-    only islands of returns, while the walls and floor around it are large connected surfaces."""
-    lab = _pieces(mesh)
+    only islands of returns, while the walls and floor around it are large connected surfaces. ``pieces``: the
+    vertices' piece labels when already computed (``_pieces``)."""
+    lab = _pieces(mesh) if pieces is None else pieces
     area = np.bincount(lab[mesh.faces[:, 0]], weights=mesh.face_areas, minlength=lab.max() + 1)
     return area[lab] < max_area
 
 
-def flat_vertices(mesh: TriMesh, min_nz: float) -> np.ndarray:
+def flat_vertices(mesh: TriMesh, min_nz: float, pieces: np.ndarray | None = None) -> np.ndarray:
     """Vertices of mesh pieces facing up or down: the area-weighted mean of their faces' normals has a vertical
-    part of at least ``min_nz`` (1: none). Such a piece is a worktop's or a shelf's return, not a front's."""
+    part of at least ``min_nz`` (1: none). Such a piece is a worktop's or a shelf's return, not a front's.
+    ``pieces`` as for ``island_vertices``."""
     if min_nz >= 1.0:
         return np.zeros(mesh.n_vertices, bool)
-    lab = _pieces(mesh)
+    lab = _pieces(mesh) if pieces is None else pieces
     piece = lab[mesh.faces[:, 0]]
     area = np.bincount(piece, weights=mesh.face_areas, minlength=lab.max() + 1)
     nz = np.bincount(piece, weights=mesh.face_areas * mesh.face_normals[:, 2], minlength=lab.max() + 1)
@@ -370,7 +372,8 @@ def missed_planes(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, cf
     vi = np.floor((mesh.vertices - lo) / cfg.voxel_m).astype(int)
     ok = np.all((vi >= 0) & (vi < np.array(shape)), axis=1)
     ok[ok] = vol[vi[ok, 0], vi[ok, 1], vi[ok, 2]]
-    ok &= island_vertices(mesh, cfg.max_island_m2) & ~flat_vertices(mesh, cfg.flat_island_nz)
+    pieces = _pieces(mesh)  # once: both tests read the same connected pieces
+    ok &= island_vertices(mesh, cfg.max_island_m2, pieces) & ~flat_vertices(mesh, cfg.flat_island_nz, pieces)
     P = mesh.vertices[ok]
     cams = np.array([-v.w2c[:3, :3].T @ v.w2c[:3, 3] for v in views])
     rng = np.random.default_rng(cfg.seed)
