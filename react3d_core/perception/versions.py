@@ -83,6 +83,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     midpoint (seams.knob_pair_gap)
 # 44: colour beside hidden scan surface is no handle again (handles.hidden_side), when the hidden surface also
 #     reaches hidden_depth from it: what an occluder hides, not the strip a handle hides from oblique views
-HEURISTIC_VERSION = "44"
+# 45: bars are also read on an orthophoto fused 3 cm in front of each plane (handles.proud_layer), where a
+#     bar standing proud is painted in its own place by every view, not smeared by their parallax
+HEURISTIC_VERSION = "45"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

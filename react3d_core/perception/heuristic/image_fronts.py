@@ -463,6 +463,43 @@ def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[in
     return np.repeat(np.repeat(local, block, 0), block, 1)[:h, :w]
 
 
+def proud_handles(layer: Orthophoto, handles: Sequence[Handle], cov: np.ndarray, outline: np.ndarray,
+                  diff: np.ndarray, thr: float, cfg: HeuristicConfig) -> list[Handle]:
+    """Bars read on ``layer`` (a plane's orthophoto fused ``handles.proud_layer`` in front of it, on the
+    plane's grid) that a proud bar would leave: parallax smears such a bar on the plane and sharpens it in
+    front, while a seam or an edge is sharpest on the plane. So a bar is kept that stands out on the layer by
+    ``handles.proud_contrast`` and ``handles.proud_gain`` times more than on the plane (``diff``: the plane's
+    colour distance from its background), on the plane too by its threshold ``thr`` (the floor seen past a
+    plane's edge through the layer is not on the plane at all), at least ``handles.proud_margin`` inside the
+    plane's coverage (nearer, the layer sees past the plane's edge), strongest first, each farther than
+    ``handles.proud_near`` from every handle already kept (the same bar, found on the plane)."""
+    hc = cfg.handles
+    layer.n_views[~cov] = 0
+    near = int(round(hc.proud_near / layer.res))
+    ldiff = off_background(layer, hc)
+    m = int(round(hc.proud_margin / layer.res))
+    # beyond the grid counts as beyond the coverage: a plane's grid ends 2 cm past its extent
+    inner = cv2.erode(cov.astype(np.uint8), np.ones((2 * m + 1, 2 * m + 1), np.uint8), borderType=cv2.BORDER_CONSTANT,
+                      borderValue=0).astype(bool) if m else cov
+    scored = []
+    for h in find_handles(layer, cov, cfg, ldiff, None, outline, bars_only=True):
+        r, c = h.pixels[:, 1], h.pixels[:, 0]
+        if not inner[r, c].all():
+            continue
+        on_layer, on_plane = float(ldiff[r, c].mean()), float(diff[r, c].mean())
+        if on_plane >= thr and on_layer >= max(hc.proud_gain * on_plane, hc.proud_contrast):
+            scored.append((on_layer, h))
+    boxes = [h.box for h in handles]
+    out = []
+    for _, h in sorted(scored, key=lambda t: -t[0]):
+        x0, y0, x1, y1 = h.box
+        if any(b[0] - near < x1 and x0 < b[2] + near and b[1] - near < y1 and y0 < b[3] + near for b in boxes):
+            continue
+        boxes.append(h.box)
+        out.append(h)
+    return out
+
+
 def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, read_rgb: Callable[[Frame], np.ndarray],
                       cfg: HeuristicConfig = HeuristicConfig(), taken_faces: np.ndarray | None = None,
                       mesh_fronts: Sequence[Front] = (),
@@ -476,7 +513,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
     planes = vertical_planes(mesh, cams.mean(0), cfg.planes, max_tilt=rules.max_tilt,
                              min_area=max(cfg.planes.min_area, rules.min_w * rules.min_h))
     orthos, calib, per_view = build_orthophotos(planes, frames, raster, mesh.n_faces, read_rgb, cfg.ortho,
-                                                cfg.calibration, cfg.registration)
+                                                cfg.calibration, cfg.registration, hc.proud_layer)
     supports: list[LineSupport] = []
     if cfg.lines.enabled and detect_lines is not None:
         supports = line_support(orthos, frames, raster, read_rgb, detect_lines, lambda fi: per_view.get(fi, calib), cfg)
@@ -531,6 +568,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         lone: list[Handle] = []
         handles = find_handles(o, cov, cfg, diff, bars & outline, outline, lone=lone)
         thr = off_threshold(diff, o.n_views > 0, cfg)
+        if o.layer is not None:
+            handles += proud_handles(o.layer, handles, cov, outline, diff, thr, cfg)
         veto_evidence.append(VetoEvidence(thr, _hardware(bars, handles)))
         shadows: list[Handle] = []
         if hc.shadows:  # handle-shaped holes above eye level: they type joints, they do not cut cells

@@ -18,7 +18,7 @@ different amount in every frame.
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import cv2
 import numpy as np
@@ -49,6 +49,7 @@ class Orthophoto:
     v_top: float
     res: float
     spread: np.ndarray | None = None  # per-pixel median |view - fused| brightness: high where things protrude (parallax)
+    layer: Orthophoto | None = None  # the same grid fused some way in front of the plane (build_orthophotos)
 
     @property
     def valid(self) -> np.ndarray:
@@ -112,19 +113,25 @@ def _grid(plane: Plane, res: float, margin: float) -> tuple[np.ndarray, float, f
 def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: Rasterizer, n_faces: int,
                       read_rgb: Callable[[Frame], np.ndarray], params: OrthoConfig = OrthoConfig(),
                       calibration: CalibrationConfig = CalibrationConfig(),
-                      registration: RegistrationConfig = RegistrationConfig()
+                      registration: RegistrationConfig = RegistrationConfig(), layer: float = 0.0
                       ) -> tuple[list[Orthophoto], ColourCalibration, dict[int, ColourCalibration]]:
     """Fused orthophoto of each plane, the scene's colour calibration (``calibration``, when enabled) and
     each registered view's own correction by frame index (``registration``, when it has sigmas; see
-    module docstring)."""
+    module docstring). With ``layer`` > 0 each orthophoto also holds, as ``layer``, the same grid fused that
+    far (m) in front of its plane from the same views in the same pass (where a handle standing that far
+    proud is painted in its own place by every view)."""
     if not planes or not frames:
         return [], ColourCalibration(), {}
+    n_planes = len(planes)
     grids = []
     for p in planes:
         span = max(p.extent_u[1] - p.extent_u[0], p.extent_v[1] - p.extent_v[0]) + 2 * params.margin
         res = max(params.resolution, span / params.max_side_px)
         grids.append((*_grid(p, res, params.margin), res))
     picks = _pick_views(planes, frames, [g[0] for g in grids], params)
+    if layer > 0:  # each plane's twin in front of it: the same grid moved along the normal, seen by the same views
+        twins = [(g[0] + (layer * p.n).astype(np.float32), *g[1:]) for g, p in zip(grids, planes)]
+        planes, grids, picks = list(planes) + [replace(p, d=p.d + layer) for p in planes], grids + twins, picks + picks
     register = calibration.enabled and bool(registration.sigmas_px)
     views: list[list[_View]] = [[] for _ in planes]
     images: dict[int, np.ndarray] = {}
@@ -155,24 +162,31 @@ def build_orthophotos(planes: Sequence[Plane], frames: Sequence[Frame], raster: 
                 views[i].append(_View.cropped(fi, xn, ok, r0, c0, None if edge_dist is None else edge_dist[ry, rx]))
         if any(v and v[-1].frame == fi for v in views):
             images[fi] = read_rgb(f)
-    calib = _calibrate(views, frames, images, calibration) if calibration.enabled else ColourCalibration()
-    per_view = register_views(*_half_grid_points(views, [g[0].shape[:2] for g in grids]), frames, images, calib,
-                              registration) if register else {}
-    out = []
-    for i, p in enumerate(planes):
-        pts, u0, v_top, res = grids[i]
-        stack = [v.paste(_sample(images[v.frame], frames[v.frame], v, per_view.get(v.frame, calib)), pts.shape[:2])
-                 for v in views[i]]
-        if stack:
-            st = np.stack(stack)
-            n = np.isfinite(st[..., 0]).sum(0)
-            color = _nanmedian(st)
-            spread = _nanmedian(np.abs(st.mean(-1) - color.mean(-1)[None]))
-        else:
-            n, color = np.zeros(pts.shape[:2], np.int32), np.zeros(pts.shape[:2] + (RGB,), np.float32)
-            spread = np.zeros(pts.shape[:2], np.float32)
-        out.append(Orthophoto(p, color, n.astype(np.int32), u0, v_top, res, spread))
-    return out, calib, per_view
+    # calibrated and registered on the planes themselves, the layers only follow
+    calib = _calibrate(views[:n_planes], frames, images, calibration) if calibration.enabled else ColourCalibration()
+    per_view = register_views(*_half_grid_points(views[:n_planes], [g[0].shape[:2] for g in grids[:n_planes]]), frames,
+                              images, calib, registration) if register else {}
+    out = [_fuse(p, grids[i], views[i], frames, images, per_view, calib) for i, p in enumerate(planes)]
+    for o, twin in zip(out, out[n_planes:]):
+        o.layer = twin
+    return out[:n_planes], calib, per_view
+
+
+def _fuse(plane: Plane, grid: tuple[np.ndarray, float, float, float], views: list[_View], frames: Sequence[Frame],
+          images: dict[int, np.ndarray], per_view: dict[int, ColourCalibration], calib: ColourCalibration) -> Orthophoto:
+    """The per-pixel median over ``views`` of one plane's grid (see module docstring)."""
+    pts, u0, v_top, res = grid
+    stack = [v.paste(_sample(images[v.frame], frames[v.frame], v, per_view.get(v.frame, calib)), pts.shape[:2])
+             for v in views]
+    if stack:
+        st = np.stack(stack)
+        n = np.isfinite(st[..., 0]).sum(0)
+        color = _nanmedian(st)
+        spread = _nanmedian(np.abs(st.mean(-1) - color.mean(-1)[None]))
+    else:
+        n, color = np.zeros(pts.shape[:2], np.int32), np.zeros(pts.shape[:2] + (RGB,), np.float32)
+        spread = np.zeros(pts.shape[:2], np.float32)
+    return Orthophoto(plane, color, n.astype(np.int32), u0, v_top, res, spread)
 
 
 def _half_grid_points(views: list[list[_View]], shapes: list[tuple[int, int]]) -> tuple[list[list[_Points]], list[int]]:
