@@ -48,7 +48,6 @@ class Orthophoto:
     u0: float
     v_top: float
     res: float
-    spread: np.ndarray | None = None  # per-pixel median |view - fused| brightness: high where things protrude (parallax)
     layer: Orthophoto | None = None  # the same grid fused some way in front of the plane (build_orthophotos)
 
     @property
@@ -182,11 +181,9 @@ def _fuse(plane: Plane, grid: tuple[np.ndarray, float, float, float], views: lis
         st = np.stack(stack)
         n = np.isfinite(st[..., 0]).sum(0)
         color = _nanmedian(st)
-        spread = _nanmedian(np.abs(st.mean(-1) - color.mean(-1)[None]))
     else:
         n, color = np.zeros(pts.shape[:2], np.int32), np.zeros(pts.shape[:2] + (RGB,), np.float32)
-        spread = np.zeros(pts.shape[:2], np.float32)
-    return Orthophoto(plane, color, n.astype(np.int32), u0, v_top, res, spread)
+    return Orthophoto(plane, color, n.astype(np.int32), u0, v_top, res)
 
 
 def _half_grid_points(views: list[list[_View]], shapes: list[tuple[int, int]]) -> tuple[list[list[_Points]], list[int]]:
