@@ -85,8 +85,6 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     reaches hidden_depth from it: what an occluder hides, not the strip a handle hides from oblique views
 # 45: bars are also read on an orthophoto fused 3 cm in front of each plane (handles.proud_layer), where a
 #     bar standing proud is painted in its own place by every view, not smeared by their parallax
-# 46: one bar standing out of the scan on a plane is enough for its colour-only handle blobs to be shading, bevels
-#     and frames, not handles (handles.bar_plane_min 2 -> 1)
-HEURISTIC_VERSION = "46"
+HEURISTIC_VERSION = "45"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

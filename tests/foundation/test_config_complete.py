@@ -461,7 +461,7 @@ DEFAULTS = {
     "perception.heuristic.handles.knob_pair_reach": 1.0,
     "perception.heuristic.handles.knob_panel_gap": 0.16,
     "perception.heuristic.handles.seam_share": 0.9,
-    "perception.heuristic.handles.bar_plane_min": 1,
+    "perception.heuristic.handles.bar_plane_min": 2,
     "perception.heuristic.handles.bar_share": 0.5,
     "perception.heuristic.handles.bar_reach": 0.0,
     "perception.heuristic.handles.proud_layer": 0.03,
