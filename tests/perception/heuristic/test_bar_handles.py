@@ -26,6 +26,7 @@ def test_bars_outrank_colour_by_hand() -> None:
     assert bars_outrank_colour([a, b, c], bars, 3, 0.5) == [a, b, c]
     assert bars_outrank_colour([a, b, c], bars, 0, 0.5) == [a, b, c]
     assert bars_outrank_colour([a, b, c], bars, 2, 0.6) == [a, b, c]
+    assert bars_outrank_colour([a, b, c], bars, 1, 0.6) == [a]  # A alone stands out: one is enough at min_bars 1
 
 
 def test_bars_outrank_colour_only_near_a_bar() -> None:
@@ -86,3 +87,29 @@ def test_colour_handles_stay_where_no_bar_stands_out() -> None:
     bars[:, 100:] = False
     o = flat_ortho(img)
     assert len(find_handles(o, np.ones(bars.shape, bool), HeuristicConfig(), protrusion=bars)) == 4
+
+
+def test_a_shaded_stile_cuts_an_oven_door_unless_one_bar_outranks_it() -> None:
+    """An oven's glass door, 0.56 x 0.8 m (140 x 200 px at 4 mm): its bar on the top rail stands out of the scan
+    (rows 30-38, cols 21-111); the pane's edge is a dark line 2 px wide (rows 48-49, cols 30-122; the pane
+    itself painted its frame's colour, as fill_panes does) and a shaded patch 3.6 x 13.6 cm on the left stile
+    (rows 138-171, cols 11-19) reads as a vertical handle by colour. At the default bar_plane_min (2) the patch
+    is a second handle and the splitter cuts the door between the two (glass tuning 323, 324: a 13 cm "drawer"
+    over the door); at 1 the bar is the door's one handle and the door one cell (measured, not the default:
+    held-apart dark lost two parts with it)."""
+    rng = np.random.default_rng(5)
+    img = np.full((200, 140, 3), 0.85, np.float32) + rng.normal(0, 0.003, (200, 140, 3)).astype(np.float32)
+    bars = np.zeros((200, 140), bool)
+    img[30:39, 21:112] = 0.6
+    bars[30:39, 21:112] = True
+    img[48:50, 30:123] = 0.45
+    img[138:172, 11:20] = 0.55
+    o = flat_ortho(img)
+    cov = np.ones(bars.shape, bool)
+    both = find_handles(o, cov, HeuristicConfig(), protrusion=bars)
+    assert sorted(h.box[:2] for h in both) == [(11, 138), (21, 30)]
+    assert len(split_cells(o, cov, both, HeuristicConfig())) == 2
+    one_bar = HeuristicConfig(handles={"bar_plane_min": 1})
+    one = find_handles(o, cov, one_bar, protrusion=bars)
+    assert [h.box[:2] for h in one] == [(21, 30)]
+    assert len(split_cells(o, cov, one, one_bar)) == 1
