@@ -463,6 +463,32 @@ def _local_surface(dn: np.ndarray, r: np.ndarray, c: np.ndarray, shape: tuple[in
     return np.repeat(np.repeat(local, block, 0), block, 1)[:h, :w]
 
 
+def pane_frame_handles(handles: Sequence[Handle], panes: np.ndarray, bars: np.ndarray, reach_px: int,
+                       share: float) -> list[Handle]:
+    """``handles`` less the colour-only ones on a pane's frame (their boxes inside the pane's box, of ``panes``,
+    grown by ``reach_px``) when a bar standing out of the scan (``share`` of its pixels on ``bars``) is on
+    the same frame.
+
+    Why: a glass-panel door is one front around its pane, and it has one handle. Its stiles are shaded by
+    the glass beside them (a patch 4 x 14 cm a little darker than the frame, on an oven's door), and a second
+    "handle" there made the splitter cut the door between the two along the pane's edge; the bar the scan
+    holds is the door's. The plane-wide rule (``bars_outrank_colour`` at one bar) mended it too but cost
+    held-apart parts elsewhere; a pane's frame is one door."""
+    if reach_px <= 0 or not len(handles) or not panes.any():
+        return list(handles)
+    n, _, stats, _ = cv2.connectedComponentsWithStats(panes.astype(np.uint8), connectivity=CONNECTIVITY)
+    on_bar = [float(bars[h.pixels[:, 1], h.pixels[:, 0]].mean()) >= share for h in handles]
+    gone: set[int] = set()
+    for k in range(1, n):
+        x, y, w, h = (int(stats[k, q]) for q in (cv2.CC_STAT_LEFT, cv2.CC_STAT_TOP, cv2.CC_STAT_WIDTH, cv2.CC_STAT_HEIGHT))
+        x0, y0, x1, y1 = x - reach_px, y - reach_px, x + w + reach_px, y + h + reach_px
+        on = [i for i, hd in enumerate(handles)
+              if hd.box[0] >= x0 and hd.box[1] >= y0 and hd.box[2] <= x1 and hd.box[3] <= y1]
+        if any(on_bar[i] for i in on):
+            gone.update(i for i in on if not on_bar[i])
+    return [hd for i, hd in enumerate(handles) if i not in gone]
+
+
 def proud_handles(layer: Orthophoto, handles: Sequence[Handle], cov: np.ndarray, outline: np.ndarray,
                   diff: np.ndarray, thr: float, cfg: HeuristicConfig) -> list[Handle]:
     """Bars read on ``layer`` (a plane's orthophoto fused ``handles.proud_layer`` in front of it, on the
@@ -567,6 +593,9 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
                 else protrusion_from_faces(o, centroids, mesh.face_normals, hc, win, cfg.planes.offset_tol))
         lone: list[Handle] = []
         handles = find_handles(o, cov, cfg, diff, bars & outline, outline, lone=lone)
+        if panes.any() and hc.pane_bar_reach > 0:
+            handles = pane_frame_handles(handles, panes, bars & outline, int(round(hc.pane_bar_reach / o.res)),
+                                         hc.bar_share)
         thr = off_threshold(diff, o.n_views > 0, cfg)
         if o.layer is not None:
             handles += proud_handles(o.layer, handles, cov, outline, diff, thr, cfg)
