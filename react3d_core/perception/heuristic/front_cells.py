@@ -15,7 +15,7 @@ seam and handle thresholds on textured planes).
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import cv2
@@ -290,6 +290,12 @@ def _at_hidden_edge(hidden: np.ndarray, protrusion: np.ndarray | None, mine: np.
     return any(a >= p.hidden_side and b >= p.hidden_side for a, b in zip(near, far))
 
 
+def stand_out(handles: Sequence[Handle], bars: np.ndarray, share: float) -> list[bool]:
+    """Per handle: at least ``share`` of its pixels lie on ``bars`` (the surface in front of the plane), so the
+    scan holds it as a bar."""
+    return [float(bars[h.pixels[:, 1], h.pixels[:, 0]].mean()) >= share for h in handles]
+
+
 def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, share: float,
                         reach_px: float = 0.0) -> list[Handle]:
     """``handles`` less the colour-only ones when at least ``min_bars`` of them (0: never) stand out of the
@@ -303,7 +309,7 @@ def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, 
     but the scan does not hold is kept on planes where no handles stand out (a decimated or a real scan)."""
     if min_bars <= 0:
         return handles
-    on_bar = [float(bars[h.pixels[:, 1], h.pixels[:, 0]].mean()) >= share for h in handles]
+    on_bar = stand_out(handles, bars, share)
     if sum(on_bar) < min_bars:
         return handles
     if reach_px <= 0:

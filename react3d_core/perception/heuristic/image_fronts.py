@@ -25,7 +25,7 @@ from ...data.mesh import TriMesh
 from ...geometry import weighted_median
 from ...raster import Rasterizer
 from .behind_glass import PaneRegion
-from .front_cells import Cell, Handle, find_handles, off_background, off_local, off_threshold, split_cells
+from .front_cells import Cell, Handle, find_handles, off_background, off_local, off_threshold, split_cells, stand_out
 from .fronts import Front, _joint, _neighbours, doors_in_rows, u_overlap
 from .line_evidence import LineSupport, line_support
 from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
@@ -477,7 +477,7 @@ def pane_frame_handles(handles: Sequence[Handle], panes: np.ndarray, bars: np.nd
     if reach_px <= 0 or not len(handles) or not panes.any():
         return list(handles)
     n, _, stats, _ = cv2.connectedComponentsWithStats(panes.astype(np.uint8), connectivity=CONNECTIVITY)
-    on_bar = [float(bars[h.pixels[:, 1], h.pixels[:, 0]].mean()) >= share for h in handles]
+    on_bar = stand_out(handles, bars, share)
     gone: set[int] = set()
     for k in range(1, n):
         x, y, w, h = (int(stats[k, q]) for q in (cv2.CC_STAT_LEFT, cv2.CC_STAT_TOP, cv2.CC_STAT_WIDTH, cv2.CC_STAT_HEIGHT))
@@ -592,10 +592,10 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         bars = (protrusion_map(o, surf, hc, win, cfg.planes.offset_tol) if rays
                 else protrusion_from_faces(o, centroids, mesh.face_normals, hc, win, cfg.planes.offset_tol))
         lone: list[Handle] = []
-        handles = find_handles(o, cov, cfg, diff, bars & outline, outline, lone=lone)
-        if panes.any() and hc.pane_bar_reach > 0:
-            handles = pane_frame_handles(handles, panes, bars & outline, int(round(hc.pane_bar_reach / o.res)),
-                                         hc.bar_share)
+        held = bars & outline
+        handles = find_handles(o, cov, cfg, diff, held, outline, lone=lone)
+        if hc.pane_bar_reach > 0:
+            handles = pane_frame_handles(handles, panes, held, int(round(hc.pane_bar_reach / o.res)), hc.bar_share)
         thr = off_threshold(diff, o.n_views > 0, cfg)
         if o.layer is not None:
             handles += proud_handles(o.layer, handles, cov, outline, diff, thr, cfg)

@@ -6,7 +6,7 @@ import numpy as np
 
 from react3d_core.config.heuristic import HeuristicConfig
 from react3d_core.perception.heuristic.front_cells import Handle, bars_outrank_colour, find_handles, split_cells
-from tests.perception.heuristic.flat_orthos import flat_ortho
+from tests.perception.heuristic.flat_orthos import flat_ortho, oven_door_image
 
 
 def _handle(c0: int, r0: int, c1: int, r1: int) -> Handle:
@@ -97,13 +97,7 @@ def test_a_shaded_stile_cuts_an_oven_door_unless_one_bar_outranks_it() -> None:
     is a second handle and the splitter cuts the door between the two (glass tuning 323, 324: a 13 cm "drawer"
     over the door); at 1 the bar is the door's one handle and the door one cell (measured, not the default:
     held-apart dark lost two parts with it)."""
-    rng = np.random.default_rng(5)
-    img = np.full((200, 140, 3), 0.85, np.float32) + rng.normal(0, 0.003, (200, 140, 3)).astype(np.float32)
-    bars = np.zeros((200, 140), bool)
-    img[30:39, 21:112] = 0.6
-    bars[30:39, 21:112] = True
-    img[48:50, 30:123] = 0.45
-    img[138:172, 11:20] = 0.55
+    img, bars = oven_door_image()
     o = flat_ortho(img)
     cov = np.ones(bars.shape, bool)
     both = find_handles(o, cov, HeuristicConfig(), protrusion=bars)

@@ -63,19 +63,15 @@ def test_no_panes_or_off() -> None:
 
 
 def test_the_oven_door_is_one_cell_with_the_rule() -> None:
-    """The oven door of test_bar_handles (bar in the scan on the top rail, the pane's dark edge, a shaded stile
+    """The oven door of ``oven_door_image`` (bar in the scan on the top rail, the pane's dark edge, a shaded stile
     patch read as a handle by colour), its pane at rows 50-169, cols 33-119: without the rule the splitter
     cuts the door between the patch and the bar (two cells); with it the bar is the one handle, one cell."""
     from react3d_core.config.heuristic import HeuristicConfig
     from react3d_core.perception.heuristic.front_cells import find_handles, split_cells
-    from tests.perception.heuristic.flat_orthos import flat_ortho
+    from tests.perception.heuristic.flat_orthos import flat_ortho, oven_door_image
 
-    rng = np.random.default_rng(5)
-    img = np.full((200, 140, 3), 0.85, np.float32) + rng.normal(0, 0.003, (200, 140, 3)).astype(np.float32)
-    panes, bars, _, _ = _oven()
-    img[30:39, 21:112] = 0.6
-    img[48:50, 30:123] = 0.45
-    img[138:172, 11:20] = 0.55
+    img, bars = oven_door_image()
+    panes = _oven()[0]
     o, cov, cfg = flat_ortho(img), np.ones(_SHAPE, bool), HeuristicConfig()
     found = find_handles(o, cov, cfg, protrusion=bars)
     assert len(split_cells(o, cov, found, cfg)) == 2
