@@ -362,7 +362,7 @@ class HandleConfig(StageConfig):
     bar_plane_min: int = Field(2, ge=0, description="On a plane where at least this many handles stand out of the scan (bar_share of their pixels on the surface in front of the plane), colour-only handles are panel bevels and shading lines, not handles (0: off).")
     bar_share: float = Field(0.5, ge=0, le=1, description="... share of a handle's pixels on that surface that makes it a handle in the scan.")
     bar_reach: float = Field(0.0, ge=0, description="With bar_plane_min: only colour-only handles within this distance (m) of a bar go (0: every one on the plane).")
-    pane_bar_reach: float = Field(0.0, ge=0, description="Opt-in (0: off; measured at 0.1). A glass pane is one door's: of the handles on its frame (their boxes inside the pane's box grown by this much, m), colour-only ones go when a bar standing out of the scan (bar_share) is among them. A shaded patch on an oven's glass-door stile, read as a second handle beside its bar, cut the door in two along the pane's edge. Off until run on the held-apart sets.")
+    pane_bar_reach: float = Field(0.1, ge=0, description="A glass pane is one door's: of the handles on its frame (their boxes inside the pane's box grown by this much, m; 0: off), colour-only ones go when a bar standing out of the scan (bar_share) is among them. A shaded patch on an oven's glass-door stile, read as a second handle beside its bar, cut the door in two along the pane's edge.")
 
 
 class CellConfig(StageConfig):

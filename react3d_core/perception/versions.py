@@ -85,6 +85,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     reaches hidden_depth from it: what an occluder hides, not the strip a handle hides from oblique views
 # 45: bars are also read on an orthophoto fused 3 cm in front of each plane (handles.proud_layer), where a
 #     bar standing proud is painted in its own place by every view, not smeared by their parallax
-HEURISTIC_VERSION = "45"
+# 46: colour-only handles on a glass pane's frame go when a bar standing out of the scan is on that frame
+#     (handles.pane_bar_reach)
+HEURISTIC_VERSION = "46"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

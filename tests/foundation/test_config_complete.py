@@ -464,7 +464,7 @@ DEFAULTS = {
     "perception.heuristic.handles.bar_plane_min": 2,
     "perception.heuristic.handles.bar_share": 0.5,
     "perception.heuristic.handles.bar_reach": 0.0,
-    "perception.heuristic.handles.pane_bar_reach": 0.0,
+    "perception.heuristic.handles.pane_bar_reach": 0.1,
     "perception.heuristic.handles.proud_layer": 0.03,
     "perception.heuristic.handles.proud_gain": 2.0,
     "perception.heuristic.handles.proud_contrast": 1.2,

@@ -4,6 +4,7 @@ bar standing out of the scan is on the same frame (image_fronts.pane_frame_handl
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from react3d_core.config.heuristic import HandleConfig
 from react3d_core.perception.heuristic.front_cells import Handle
@@ -59,7 +60,7 @@ def test_no_panes_or_off() -> None:
     panes, bars, bar, patch = _oven()
     assert pane_frame_handles([bar, patch], np.zeros(_SHAPE, bool), bars, _REACH, 0.5) == [bar, patch]
     assert pane_frame_handles([bar, patch], panes, bars, 0, 0.5) == [bar, patch]
-    assert HandleConfig().pane_bar_reach == 0.0  # opt-in
+    assert HandleConfig().pane_bar_reach == pytest.approx(0.1)  # on by default
 
 
 def test_the_oven_door_is_one_cell_with_the_rule() -> None:
