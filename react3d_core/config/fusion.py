@@ -19,6 +19,7 @@ class FusionConfig(StageConfig):
     work_width: int | None = Field(320, ge=16, description="Render, lift and score views at this image width (None: the masks' own size).")
     weld_m: float = Field(0.005, ge=0, description="Vertices closer than this count as one for connectivity (scans may not be welded).")
     attach_m: float = Field(0.02, ge=0, description="Components this close to a part's largest component stay with it (handles on doors).")
+    keep_share: float = Field(0.2, ge=0, le=1, description="A proposal or part is cut to its largest connected component, with the components within attach_m of it and those holding at least this share of its area (1: the largest alone). A glass door's frame whose thin rails the scan or the fusion mesh broke is two stiles a pane apart, each about half the door.")
     max_anchors: int = Field(8, ge=1, description="Face graph: anchor faces sampled per mask (each lifted face is paired with them; enough to bridge gaps).")
     distinct_jaccard: float = Field(0.95, ge=0, le=1, description="A community found again at another resolution (face Jaccard above this) is merged into the first.")
     claimed_share: float = Field(0.8, ge=0, le=1, description="A proposal with more than this share of its faces in earlier candidates is not re-segmented (it would re-segment to them).")

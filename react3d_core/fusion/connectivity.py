@@ -53,20 +53,27 @@ def surface_distance(triangles: np.ndarray, points: np.ndarray) -> np.ndarray:
     return Rasterizer(TriMesh(v, np.arange(len(v)).reshape(-1, 3))).distance(points)
 
 
-def largest_component(mesh: TriMesh, wfaces: np.ndarray, face_ids: np.ndarray, attach_m: float = 0.0) -> np.ndarray:
-    """Faces of the largest (by area) component, plus components within ``attach_m`` of it.
+def largest_component(mesh: TriMesh, wfaces: np.ndarray, face_ids: np.ndarray, attach_m: float = 0.0,
+                      keep_share: float = 1.0) -> np.ndarray:
+    """Faces of the largest (by area) component, plus components within ``attach_m`` of it and
+    components holding at least ``keep_share`` of the faces' area (1: none).
 
     Why the attachment: a handle modelled or scanned as a separate shell touching the door
-    surface shares no vertex with it, yet moves with it.
+    surface shares no vertex with it, yet moves with it. Why the share: a glass door's frame whose
+    thin rails the scan (or the fusion mesh's decimation) broke is two stiles a pane apart, each
+    about half the door; the largest alone is a sliver no view's mask matches.
     """
     face_ids = np.unique(np.asarray(face_ids, np.int64))
     n, lab = face_components(wfaces, face_ids)
     if n <= 1:
         return face_ids
     tri = mesh.vertices[mesh.faces[face_ids]]
-    big = int(np.argmax(np.bincount(lab, weights=mesh.face_areas[face_ids], minlength=n)))
+    area = np.bincount(lab, weights=mesh.face_areas[face_ids], minlength=n)
+    big = int(np.argmax(area))
     keep = lab == big
-    if attach_m > 0:
+    if keep_share < 1.0:
+        keep |= np.isin(lab, np.flatnonzero(area >= keep_share * area.sum()))
+    if attach_m > 0 and not keep.all():
         d = surface_distance(tri[keep], tri[~keep].reshape(-1, 3)).reshape(-1, 3)
         near_comp = np.unique(lab[~keep][(d <= attach_m).any(1)])
         keep |= np.isin(lab, near_comp)

@@ -118,7 +118,7 @@ def fuse_proposals(lifts: Sequence[FrameLift], mesh: TriMesh, config: PipelineCo
     for res, com in comms:
         if len(com) <= fc.min_community_faces:
             continue
-        com = largest_component(fm.mesh, fm.wfaces, com)
+        com = largest_component(fm.mesh, fm.wfaces, com, keep_share=fc.keep_share)
         if len(com) > fc.min_community_faces:
             kept.append((res, com))
     out: list[Proposal] = []

@@ -158,4 +158,4 @@ def resegment(
     allf = np.unique(np.concatenate(faces)).astype(np.int64)
     if not len(allf):
         return allf, mask
-    return largest_component(mesh, wfaces, allf, config.fusion.attach_m), mask
+    return largest_component(mesh, wfaces, allf, config.fusion.attach_m, config.fusion.keep_share), mask

@@ -194,7 +194,7 @@ def candidates_from_proposals(
             continue
         kept, n, d = clip_part(mesh, faces, frame.c2w[:3, 3], config.clip)
         if n is not None and len(kept):
-            kept = largest_component(mesh, wfaces, kept, config.fusion.attach_m)
+            kept = largest_component(mesh, wfaces, kept, config.fusion.attach_m, config.fusion.keep_share)
         outcomes[i] = ProposalOutcome("candidate" if len(kept) else "clip_empty", np.asarray(faces, np.int64),
                                       np.asarray(kept, np.int64))
         if not len(kept):

@@ -120,6 +120,27 @@ def test_components_weld_and_attach():
     assert set(keep.tolist()) == set(np.concatenate([ia, ib, ih]).tolist())
 
 
+def test_components_kept_by_share():
+    """A glass door's frame with its rails broken: two stiles a pane apart (0.10 x 0.60 m each, 0.06 m²) and a
+    stray chip (0.05 x 0.05 m, 0.0025 m²). Shares of the 0.1225 m²: 0.49, 0.49, 0.02. At keep_share 0.2 both
+    stiles stay and the chip goes; at 1 (the largest alone) one stile is left; at 0.01 all three."""
+    left = grid(0.0, 0.1, 0.0, 0.6, 0.0, 2, 6)
+    right = grid(0.4, 0.5, 0.0, 0.6, 0.0, 2, 6)
+    chip = grid(0.9, 0.95, 0.0, 0.05, 0.0, 1, 1)
+    m, (il, ir, ic) = merge(left, right, chip)
+    wf = weld_labels(m.vertices, 0.005)[m.faces]
+    every = np.arange(m.n_faces)
+    assert m.face_areas[il].sum() == pytest.approx(0.06) and m.face_areas[ic].sum() == pytest.approx(0.0025)
+    assert set(largest_component(m, wf, every, keep_share=0.2).tolist()) == set(np.concatenate([il, ir]).tolist())
+    one = largest_component(m, wf, every)  # the default of the function: the largest alone (ties: the first)
+    assert set(one.tolist()) == set(il.tolist())
+    assert len(largest_component(m, wf, every, keep_share=0.01)) == m.n_faces
+    # 0.0025 / 0.1225 = 0.0204: kept at a share just under it, not just over it
+    assert len(largest_component(m, wf, every, keep_share=0.0203)) == m.n_faces
+    assert len(largest_component(m, wf, every, keep_share=0.0205)) == len(il) + len(ir)
+    assert PipelineConfig().fusion.keep_share == pytest.approx(0.2)
+
+
 # -- fusion on rendered hand-made scenes ------------------------------------------------------
 def _lifts(mesh: TriMesh, parts: list[np.ndarray], frs, config):
     R = Rasterizer(mesh)
