@@ -227,6 +227,18 @@ def candidates_from_proposals(
     return merge_instances(out, mesh) if config.fusion.merge_instances else out
 
 
+def pieces_config(masks: Mapping[str, Sequence[Mask2D]], config: PipelineConfig) -> PipelineConfig:
+    """``config`` as the cuts to a connected component read it: ``fusion.keep_share`` holds only when the masks
+    name the object they show (``Mask2D.instance``: a backend rendering each of its 3D fronts into every view,
+    which sets it on every mask or none; the first mask tells). Such a mask is a whole front, so a piece holding
+    a fifth of it is that front's; a detector's mask, or the oracle's noisy one, can reach into a neighbour, and a
+    piece of that is not (oracle, held-apart glass: 112 -> 110 of 117 with the share)."""
+    first = next((ms[0] for ms in masks.values() if len(ms)), None)
+    if (first is not None and first.instance is not None) or config.fusion.keep_share >= 1.0:
+        return config
+    return config.model_copy(update={"fusion": config.fusion.model_copy(update={"keep_share": 1.0})})
+
+
 def segment_parts(
     scene: SceneInput,
     mesh: TriMesh,
@@ -244,6 +256,7 @@ def segment_parts(
     (decimated, welded) mesh across calls; ``trace`` (optional) receives the intermediate results.
     """
     t = timings if timings is not None else {}
+    config = pieces_config(masks, config)
     t0 = time.perf_counter()
     rasterizer = rasterizer or Rasterizer(mesh)
     fm = fusion_mesh or prepare_fusion_mesh(mesh, config)

@@ -141,6 +141,22 @@ def test_components_kept_by_share():
     assert PipelineConfig().fusion.keep_share == pytest.approx(0.2)
 
 
+def test_pieces_kept_only_for_masks_naming_their_object():
+    """keep_share holds for masks that name the object they show (a backend rendering its 3D fronts), not for a
+    detector's or the oracle's (instance None): the cuts then keep the largest component alone."""
+    from react3d_core.fusion.segment import pieces_config
+
+    m = np.zeros((4, 4), bool)
+    m[1:3, 1:3] = True
+    named = {"f0": [], "f1": [Mask2D(frame_id="f1", label="door", score=1.0, mask=m, instance=3)]}
+    unnamed = {"f1": [Mask2D(frame_id="f1", label="door", score=1.0, mask=m)]}
+    c = PipelineConfig()
+    assert pieces_config(named, c).fusion.keep_share == pytest.approx(0.2)
+    assert pieces_config(unnamed, c).fusion.keep_share == 1.0
+    assert pieces_config({}, c).fusion.keep_share == 1.0
+    assert c.fusion.keep_share == pytest.approx(0.2)  # the caller's config is not changed
+
+
 # -- fusion on rendered hand-made scenes ------------------------------------------------------
 def _lifts(mesh: TriMesh, parts: list[np.ndarray], frs, config):
     R = Rasterizer(mesh)
