@@ -14,7 +14,7 @@ from .reseg import point_prompts, resegment
 from .segment import lift_frames, segment_parts
 from .topk import select_top_views
 
-STAGE_VERSION = "7"  # 2: a candidate carries its views' mask label (perception's tag); 3: an inner mask whose view sees little of the proposal does not outrank border masks (topk.min_view_cover); 4: pixels seen through the front are not lifted; 5: a lid is clipped to its top's horizontal plane; 6: the faces a lid's clip left out (its skirts) make no candidate of their own; 7: candidates showing one perceived object are one part (fusion.merge_instances)
+STAGE_VERSION = "8"  # 2: a candidate carries its views' mask label (perception's tag); 3: an inner mask whose view sees little of the proposal does not outrank border masks (topk.min_view_cover); 4: pixels seen through the front are not lifted; 5: a lid is clipped to its top's horizontal plane; 6: the faces a lid's clip left out (its skirts) make no candidate of their own; 7: candidates showing one perceived object are one part (fusion.merge_instances)
 STAGE = StageSpec("fusion", __name__, STAGE_VERSION, sections=("fusion", "topk", "clip"), upstream=("perception",))
 
 __all__ = [
