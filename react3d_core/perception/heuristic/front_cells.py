@@ -366,13 +366,16 @@ def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int, gap: 
 
 
 def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg: HeuristicConfig,
-                lines: tuple[np.ndarray, np.ndarray] | None = None, lone: list[Handle] = ()) -> list[Cell]:
+                lines: tuple[np.ndarray, np.ndarray] | None = None, lone: list[Handle] = (),
+                panes: np.ndarray | None = None) -> list[Cell]:
     """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs.
     ``lines``: pixels on vertical and on horizontal lines that learned line segments of several views
     support (line_evidence.py; ``perception.heuristic.lines``), a seam where the brightness shows none.
     ``lone``: knobs not taken as handles; with ``cells.lone_knobs_block`` no cut runs through them either
     (a chest's wide top drawer has one knob in its middle, over the seam between the two drawers of each
-    row below; the seam's line ran on up through the knob and halved the top drawer)."""
+    row below; the seam's line ran on up through the knob and halved the top drawer).
+    ``panes``: the plane's glass panes (``image_fronts.framed_panes``); with ``cells.pane_margin`` > 0 no cut
+    runs through a pane or within that margin of it."""
     rows, cols = np.nonzero(coverage)
     if not len(rows):
         return []
@@ -409,8 +412,10 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
             else:
                 along_c[h.box[0]:h.box[2]] = True
         learned = LearnedLines(lines[0], lines[1], cfg.lines.span, along_c, along_r)
+    boxes = (pane_boxes(panes, int(round(cells_cfg.pane_margin / o.res)))
+             if panes is not None and cells_cfg.pane_margin > 0 else [])
     cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, gs, cols, learned,
-                   int(cells_cfg.edge_strip / o.res), pull_px)
+                   int(cells_cfg.edge_strip / o.res), pull_px, boxes)
     if pair_px:
         handles = _split_bar_pairs(handles, cells, pair_px)
     for c in cells:
@@ -423,8 +428,8 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
     out: list[Cell] = []
     for c in cells:
         pitched = _pitch_split(c, gs[1], coverage, min_px, p, cells_cfg.pitch_tol) if cells_cfg.pitch_tol > 0 else None
-        for piece in pitched or _split_handles(c, vert, horiz, coverage, min_px, gs, p, learned):
-            out += _split_at_pulls(piece, gs[1], coverage, min_px, pull_px, p)
+        for piece in pitched or _split_handles(c, vert, horiz, coverage, min_px, gs, p, learned, boxes):
+            out += _split_at_pulls(piece, gs[1], coverage, min_px, pull_px, p, boxes)
     if cells_cfg.sliver_max > 0:
         out = merge_slivers(out, int(cells_cfg.sliver_max / o.res), cells_cfg.sliver_ratio)
     return out
@@ -747,9 +752,46 @@ def _plateau_middle(v: np.ndarray) -> int:
     return (i + j) // 2
 
 
+def pane_boxes(panes: np.ndarray, margin_px: int, core: float = 0.5) -> list[tuple[int, int, int, int]]:
+    """Boxes (c0, r0, c1, r1) of the glass panes in mask ``panes``, grown by ``margin_px``: each pane's
+    columns holding at least ``core`` of its fullest column's pixels, and its rows likewise.
+
+    Why: a pane lies inside one door. Painted with its frame's colour it still differs from the frame a
+    little (shading, the frame's inner edge), and the splitter cut glass doors along a pane's edge or
+    across it at a shelf seen through the glass (glass tuning: a cupboard's three glass doors cut at their
+    panes' edges, a wall cabinet's glass door halved across its pane). The core, not the bounding box: a
+    pane that leaked through a speck of the frame into the gap beside it barred the seam there."""
+    if not panes.any():
+        return []
+    n, lab, stats, _ = cv2.connectedComponentsWithStats(panes.astype(np.uint8), connectivity=CONNECTIVITY)
+    h, w = panes.shape
+    out = []
+    for k in range(1, n):
+        x, y, bw, bh = (int(v) for v in stats[k, :4])
+        me = lab[y:y + bh, x:x + bw] == k
+        cols, rows = me.sum(0), me.sum(1)
+        cs, rs = np.flatnonzero(cols >= core * cols.max()), np.flatnonzero(rows >= core * rows.max())
+        out.append((max(0, x + int(cs[0]) - margin_px), max(0, y + int(rs[0]) - margin_px),
+                    min(w, x + int(cs[-1]) + 1 + margin_px), min(h, y + int(rs[-1]) + 1 + margin_px)))
+    return out
+
+
+def _pane_blocks(c: Cell, panes: Sequence[tuple[int, int, int, int]]) -> tuple[np.ndarray, np.ndarray]:
+    """Columns and rows of cell ``c`` (local indices) that a cut may not take: those of every pane box
+    overlapping the cell, where a cut would run through the pane or along its edge."""
+    pc = np.zeros(c.c1 - c.c0, bool)
+    pr = np.zeros(c.r1 - c.r0, bool)
+    for b0, a0, b1, a1 in panes:
+        if b0 < c.c1 and b1 > c.c0 and a0 < c.r1 and a1 > c.r0:
+            pc[max(b0, c.c0) - c.c0:min(b1, c.c1) - c.c0] = True
+            pr[max(a0, c.r0) - c.r0:min(a1, c.r1) - c.r0] = True
+    return pc, pr
+
+
 def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: SeamConfig, q: CellConfig, min_px: int,
            depth: int, bc: np.ndarray, br: np.ndarray, handles: list[Handle], g: tuple[np.ndarray, np.ndarray],
-           col: tuple[np.ndarray, np.ndarray], learned: LearnedLines | None = None, strip_px: int = 0, pull_px: int = 0) -> list[Cell]:
+           col: tuple[np.ndarray, np.ndarray], learned: LearnedLines | None = None, strip_px: int = 0, pull_px: int = 0,
+           panes: Sequence[tuple[int, int, int, int]] = ()) -> list[Cell]:
     """Recursive guillotine split at the strongest straight seam (``_dip_cut``), else at a line that
     ``learned`` line segments support, else at the most prominent seam by valley counts.
     Inside a cell holding handles, a horizontal cut must leave a handle on both sides (glossy fronts
@@ -758,13 +800,16 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
     bottom edge (``cells.edge_strip``): a plinth or a worktop's edge, cut off and dropped; or the cut is a
     straight dark seam (a dip, not a valley count: a bar's own rim makes those) within ``pull_px`` of a
     horizontal bar's top edge (``cells.edge_pull``): the seam an edge pull hangs from, whose front's
-    neighbour above shows no handle when its own pull lies on the outline."""
+    neighbour above shows no handle when its own pull lies on the outline. No cut runs through or along a
+    glass pane of ``panes`` (grid boxes c0, r0, c1, r1, grown by their margin; ``pane_boxes``)."""
     if depth >= q.max_split_depth:
         return [c]
     sl = (slice(c.r0, c.r1), slice(c.c0, c.c1))
+    pc, pr = _pane_blocks(c, panes)
+    bcl, brl = bc[c.c0:c.c1] | pc, br[c.r0:c.r1] | pr
     if q.outline_step > 0:  # an L-shaped outline splits at its corner before any seam is sought
-        ov, sv = _outline_cut(cov[sl], 0, min_px, bc[c.c0:c.c1])
-        oh, sh = _outline_cut(cov[sl], 1, min_px, br[c.r0:c.r1])
+        ov, sv = _outline_cut(cov[sl], 0, min_px, bcl)
+        oh, sh = _outline_cut(cov[sl], 1, min_px, brl)
         if max(sv, sh) >= q.outline_step:  # columns first: a run splits into units, a unit into fronts
             if sv >= q.outline_step:
                 a = Cell(c.c0, c.r0, c.c0 + ov, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
@@ -772,14 +817,14 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
             else:
                 a = Cell(c.c0, c.r0, c.c1, c.r0 + oh, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
                 b = Cell(c.c0, c.r0 + oh + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts)
-            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px, pull_px)
-                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px, pull_px))
-    cv_, sc_v = _dip_cut(g[0][sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])   # profile over columns
-    ch_, sc_h = _dip_cut(g[1][sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])   # profile over rows
+            return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px, pull_px, panes)
+                    + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, handles, g, col, learned, strip_px, pull_px, panes))
+    cv_, sc_v = _dip_cut(g[0][sl], cov[sl], 0, min_px, p, bcl)   # profile over columns
+    ch_, sc_h = _dip_cut(g[1][sl], cov[sl], 1, min_px, p, brl)   # profile over rows
     if p.ridges and not any(c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1 for h in handles):
         # a handle-less cell: a straight row brighter than both sides along the whole cell is a seam too
         # (the top edge of the drawer below, lit from above; a vertical gap catches no such light)
-        rh_, rs_h = _dip_cut(-g[1][sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
+        rh_, rs_h = _dip_cut(-g[1][sl], cov[sl], 1, min_px, p, brl)
         if rs_h > sc_h:
             ch_, sc_h = rh_, rs_h
     sc_v = sc_v if sc_v >= p.dip_z else 0.0
@@ -789,8 +834,8 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
         # a colour step along the whole cell (a front of another colour than its surround or its
         # neighbour); with ``step_over_dip`` it wins where it is stronger than the best dark line (a
         # shaker door's frame casts a straight dark line a few cm inside its own edge)
-        sv_, st_v = _dip_cut(col[0][sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1], _step_scores)
-        sh_, st_h = _dip_cut(col[1][sl], cov[sl], 1, min_px, p, br[c.r0:c.r1], _step_scores)
+        sv_, st_v = _dip_cut(col[0][sl], cov[sl], 0, min_px, p, bcl, _step_scores)
+        sh_, st_h = _dip_cut(col[1][sl], cov[sl], 1, min_px, p, brl, _step_scores)
         st_v = st_v if st_v >= p.step_z else 0.0
         st_h = st_h if st_h >= p.step_z else 0.0
         if st_v > sc_v:
@@ -800,20 +845,20 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
     straight = int(dip_v if sc_v >= sc_h else dip_h) if max(sc_v, sc_h) > 0.0 else 0
     if max(sc_v, sc_h) == 0.0 and q.groove_share > 0:
         # a groove: a narrow band the scan's surface leaves along the whole cell (a TSDF seam)
-        cv_, sc_v = _groove_cut(cov[sl], 0, min_px, q, bc[c.c0:c.c1], p.piece_sides)
-        ch_, sc_h = _groove_cut(cov[sl], 1, min_px, q, br[c.r0:c.r1], p.piece_sides)
+        cv_, sc_v = _groove_cut(cov[sl], 0, min_px, q, bcl, p.piece_sides)
+        ch_, sc_h = _groove_cut(cov[sl], 1, min_px, q, brl, p.piece_sides)
         straight = int(max(sc_v, sc_h) > 0.0)
     if max(sc_v, sc_h) == 0.0 and learned is not None:
         # a straight line that the learned segments of several views agree on (a seam in a glossy or
         # evenly lit front shows no dark line)
         cv_, sc_v = _line_cut(learned.vert[sl], cov[sl], 0, min_px, learned.span, p.span_chunks,
-                              learned.blocked_c[c.c0:c.c1])
+                              learned.blocked_c[c.c0:c.c1] | pc)
         ch_, sc_h = _line_cut(learned.horiz[sl], cov[sl], 1, min_px, learned.span, p.span_chunks,
-                              learned.blocked_r[c.r0:c.r1])
+                              learned.blocked_r[c.r0:c.r1] | pr)
         straight = int(max(sc_v, sc_h) > 0.0)
     if max(sc_v, sc_h) == 0.0:
-        cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bc[c.c0:c.c1])
-        ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, br[c.r0:c.r1])
+        cv_, sc_v = _best_cut(vert[sl], cov[sl], 0, min_px, p, bcl)
+        ch_, sc_h = _best_cut(horiz[sl], cov[sl], 1, min_px, p, brl)
         sc_v = sc_v if sc_v >= p.prominence else 0.0
         sc_h = sc_h if sc_h >= p.prominence_h else 0.0
     mine = [h for h in handles if c.c0 <= h.center[0] < c.c1 and c.r0 <= h.center[1] < c.r1]
@@ -825,7 +870,7 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
                 # the strip is no front: the cell goes on without it, its sides as they were
                 rest = (Cell(c.c0, c.r0, c.c1, cut, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts) if above
                         else Cell(c.c0, cut + 1, c.c1, c.r1, cut_sides=c.cut_sides, seam_cuts=c.seam_cuts))
-                return _split(rest, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px)
+                return _split(rest, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px, panes)
             sc_h = 0.0
     if max(sc_v, sc_h) == 0.0:
         return [c]
@@ -843,19 +888,22 @@ def _split(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, p: Sea
                 b.seam_cuts = c.seam_cuts
             elif b.r1 - b.r0 <= strip_px < a.r1 - a.r0:
                 a.seam_cuts = c.seam_cuts
-    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px)
-            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px))
+    return (_split(a, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px, panes)
+            + _split(b, vert, horiz, cov, p, q, min_px, depth + 1, bc, br, mine, g, col, learned, strip_px, pull_px, panes))
 
 
-def _split_at_pulls(c: Cell, g: np.ndarray, cov: np.ndarray, min_px: int, pull_px: int, p: SeamConfig) -> list[Cell]:
+def _split_at_pulls(c: Cell, g: np.ndarray, cov: np.ndarray, min_px: int, pull_px: int, p: SeamConfig,
+                    panes: Sequence[tuple[int, int, int, int]] = ()) -> list[Cell]:
     """Cut a cell along the seam an edge pull hangs from: for its horizontal bar lowest down first, the row
     within ``pull_px`` above the bar's top edge where the brightness (``g``, handles filled in along rows)
     dips most, when that dip scores at least ``seams.between_z`` noise units (the bar vouches for the seam
     as a second handle does in ``_between``) and leaves ``min_px`` rows above. Why: a chest's lips sit on
     the seams above them; with the top drawer's lip on the outline, each seam had a handle below and none
-    above, and a white-on-white TSDF seam is too faint for a straight cut by itself (``seams.dip_z``)."""
+    above, and a white-on-white TSDF seam is too faint for a straight cut by itself (``seams.dip_z``).
+    No cut runs through a glass pane of ``panes``: a bar on a glass door's bottom rail hangs from no seam."""
     if pull_px <= 0:
         return [c]
+    pr = _pane_blocks(c, panes)[1]
     bars = sorted((h for h in c.handles if h.horizontal and not h.knob), key=lambda h: -h.box[1])
     for h in bars:
         lo, hi = h.box[1] - pull_px, h.box[1] + 1
@@ -866,9 +914,11 @@ def _split_at_pulls(c: Cell, g: np.ndarray, cov: np.ndarray, min_px: int, pull_p
         if not len(z) or z.max() < p.between_z:
             continue
         cut = lo + int(np.argmax(z))
+        if pr[cut - c.r0]:
+            continue
         a = Cell(c.c0, c.r0, c.c1, cut, [k for k in c.handles if k.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(c.c0, cut + 1, c.c1, c.r1, [k for k in c.handles if k.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
-        return _split_at_pulls(a, g, cov, min_px, pull_px, p) + [b]
+        return _split_at_pulls(a, g, cov, min_px, pull_px, p, panes) + [b]
     return [c]
 
 
@@ -976,11 +1026,15 @@ def _door_pair_knobs(a: tuple[int, int, int, int], b: tuple[int, int, int, int],
 
 
 def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int, g: tuple[np.ndarray, np.ndarray],
-                   p: SeamConfig, learned: LearnedLines | None = None) -> list[Cell]:
+                   p: SeamConfig, learned: LearnedLines | None = None,
+                   panes: Sequence[tuple[int, int, int, int]] = ()) -> list[Cell]:
     """Split a cell between consecutive handles (side by side: at the best column between them;
-    stacked: at the best row), recursively, so every cell ends with at most one handle per row/column."""
+    stacked: at the best row), recursively, so every cell ends with at most one handle per row/column;
+    never through or along a glass pane of ``panes`` (one door: its second "handle" is the frame's shading
+    or a shelf's lip behind the glass)."""
     if len(c.handles) < 2:
         return [c]
+    pc, pr = _pane_blocks(c, panes)
     hs = sorted(c.handles, key=lambda h: h.center[0])
     xs = [h.center[0] for h in hs]
     ys = sorted(h.center[1] for h in hs)
@@ -1009,7 +1063,7 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
         cut = c.c0 + at
         a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
-        if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1):
+        if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1) or pc[cut - c.c0]:
             return [c]  # handles overlapping across the cut (a bar seen twice): nothing to separate
     else:
         hs = sorted(c.handles, key=lambda h: h.center[1])
@@ -1024,7 +1078,7 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
                               (int(ys[k]) - c.r0, int(ys[k + 1]) - c.r0))
         a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
         b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
-        if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1):
+        if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1) or pr[cut - c.r0]:
             return [c]
-    return (_split_handles(a, vert, horiz, cov, min_px, g, p, learned)
-            + _split_handles(b, vert, horiz, cov, min_px, g, p, learned))
+    return (_split_handles(a, vert, horiz, cov, min_px, g, p, learned, panes)
+            + _split_handles(b, vert, horiz, cov, min_px, g, p, learned, panes))

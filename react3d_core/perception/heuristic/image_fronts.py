@@ -218,12 +218,18 @@ def enclosed_holes(seen: np.ndarray, outline: np.ndarray, res: float, min_thick:
     return keep[lab]
 
 
-def seen_rim(seen: np.ndarray, res: float, depth: float) -> np.ndarray:
+def seen_rim(seen: np.ndarray, res: float, depth: float, sides: bool = False) -> np.ndarray:
     """What ``seen`` marks within ``depth`` (m) of the first seen pixel from the top and from the bottom of
-    each column: the plane's top and bottom edges as the views see them.
+    each column, and with ``sides`` from the left and from the right of each row: the plane's edges as the
+    views see them.
 
     Why: on a TSDF scan a cupboard's top rail lies on the fused box's rounded top edge, outside the plane's
-    coverage and farther from it than the views' reach, so its pane ran out of the plane over the top."""
+    coverage and farther from it than the views' reach, so its pane ran out of the plane over the top. The
+    stiles of the doors at either end lie on the box's rounded side edges the same way, and their panes ran
+    out sideways (glass tuning TSDF: a white cupboard's end door, its outer stile fused only below the pane's
+    middle)."""
+    if sides:
+        return seen_rim(seen, res, depth) | seen_rim(seen.T, res, depth).T
     r = int(round(depth / res))
     h = seen.shape[0]
     if r <= 0 or not seen.any():
@@ -236,7 +242,8 @@ def seen_rim(seen: np.ndarray, res: float, depth: float) -> np.ndarray:
 
 
 def pane_frame_map(cov: np.ndarray, seen: np.ndarray | None, res: float, speck: float, gap: float,
-                   reach: float | None = None, max_cover: float = 1.0, rim: float = 0.0) -> np.ndarray:
+                   reach: float | None = None, max_cover: float = 1.0, rim: float = 0.0,
+                   rim_sides: bool = False) -> np.ndarray:
     """What may frame a pane: the plane's coverage, joined with ``seen`` (what the views see at the
     plane's depth) when given, with covered strokes and specks thinner than ``speck`` (m) taken off, then
     gaps up to ``gap`` (m) closed.
@@ -258,7 +265,7 @@ def pane_frame_map(cov: np.ndarray, seen: np.ndarray | None, res: float, speck: 
             return cov.copy()
         out |= near.astype(np.uint8)
         if rim > 0:  # a rail on the box's rounded edge: seen at the plane's depth, at the plane's edge
-            out |= seen_rim(seen, res, rim).astype(np.uint8)
+            out |= seen_rim(seen, res, rim, rim_sides).astype(np.uint8)
     k = int(round(speck / res)) | 1  # odd: an even kernel shifts what it keeps by a pixel
     if k >= MIN_KERNEL:
         out = cv2.morphologyEx(out, cv2.MORPH_OPEN, np.ones((k, k), np.uint8))
@@ -575,7 +582,7 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
         framing = pane_frame_map(cov, seen_at_plane if cfg.image.pane_seen else None, o.res, cfg.image.pane_speck,
                                  cfg.image.pane_gap, cfg.image.pane_seen_reach, cfg.image.pane_seen_max_cover,
-                                 cfg.image.pane_seen_rim)
+                                 cfg.image.pane_seen_rim, cfg.image.pane_seen_rim_sides)
         panes = framed_panes(framing, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
                              cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
                              cfg.image.pane_min_fill)
@@ -613,7 +620,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         p = o.plane
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
-        cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None, lone)
+        cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None, lone,
+                            panes)
         tiled = is_tiled(cells, cov, o.res, cfg.cells)
         mine: list[Front] = []
         for cell in cells:
