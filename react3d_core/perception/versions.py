@@ -88,7 +88,7 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 46: colour-only handles on a glass pane's frame go when a bar standing out of the scan is on that frame
 #     (handles.pane_bar_reach)
 # 47: no cut runs through or along a glass pane (cells.pane_margin), panes are framed at 85 % of their band
-#     (image.pane_frame_cover), the views' left and right plane edges frame panes too (image.pane_seen_rim_sides),
+#     (image.pane_frame_cover), the views' left and right plane edges may frame panes (image.pane_seen_rim_sides, opt-in),
 #     and vertical planes from 0.05 m² are photographed (planes.min_area: a microwave's door around its window)
 HEURISTIC_VERSION = "47"
 # 2: says "sliding" for GT prismatic joints in the part's front plane

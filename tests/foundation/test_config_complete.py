@@ -319,7 +319,7 @@ DEFAULTS = {
     "perception.heuristic.image.pane_seen_reach": 0.035,
     "perception.heuristic.image.pane_seen_max_cover": 0.9,
     "perception.heuristic.image.pane_seen_rim": 0.035,
-    "perception.heuristic.image.pane_seen_rim_sides": True,
+    "perception.heuristic.image.pane_seen_rim_sides": False,
     "perception.heuristic.image.pane_speck": 0.02,
     "perception.heuristic.image.pane_gap": 0.08,
     "perception.heuristic.image.pane_rounds": 3,
