@@ -227,7 +227,7 @@ def test_bench_sets_pass_scan_options() -> None:
 
 HELD_APART = ("heldout", "heldout_laser", "heldout_tsdf", "large_kitchens", "free_standing_heldout", "glass_heldout", "dark_heldout")
 TUNING = ("tuning_realistic", "tuning_realistic_2", "wardrobes_tuning", "large_kitchens_tuning", "free_standing_tuning",
-          "free_standing_tuning_2", "glass_tuning", "dark_tuning", "dark_tuning_2")
+          "free_standing_tuning_2", "glass_tuning", "glass_tuning_2", "dark_tuning", "dark_tuning_2")
 
 
 def test_tuning_and_held_apart_seeds_never_overlap() -> None:
