@@ -238,12 +238,12 @@ def write_npz(path: str | Path, **arrays: np.ndarray) -> Path:
 def read_npz(path: str | Path) -> dict[str, np.ndarray]:
     """Read an ``.npz`` written by :func:`write_npz` (pickles refused)."""
     from .errors import InputError
+    from .npyio import load_npz
 
     path = Path(path)
     if not path.is_file():
         raise InputError(path, "file not found")
     try:
-        with np.load(path, allow_pickle=False) as z:
-            return {k: z[k] for k in z.files}
+        return load_npz(path)
     except Exception as exc:  # noqa: BLE001 - turn any decode failure into one clear line
         raise InputError(path, f"not a readable .npz archive ({exc.__class__.__name__}: {exc})") from None

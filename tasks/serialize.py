@@ -18,6 +18,8 @@ from typing import Any
 import numpy as np
 from pydantic import BaseModel
 
+from react3d_core.npyio import load_npz
+
 ALLOWED_PREFIX = "react3d_core."
 
 
@@ -113,8 +115,7 @@ def loads(data: bytes) -> Any:
 def loads_sized(data: bytes) -> tuple[Any, int]:
     """:func:`loads`, and roughly how many bytes the decoded arrays take (packed masks count unpacked):
     what keeping the object in memory costs."""
-    with np.load(io.BytesIO(data), allow_pickle=False) as z:
-        arrays = {k: z[k] for k in z.files}
+    arrays = load_npz(data)
     tree_bytes = arrays.pop("__tree__").tobytes()
     tree = json.loads(tree_bytes.decode())
     packed = set(_bit_keys(tree))

@@ -22,6 +22,7 @@ import numpy as np
 import trimesh
 
 from ..atomic import atomic_path
+from ..npyio import load_npz
 from ..data.mesh import TriMesh
 
 MAX_HULL_VERTICES = 200  # PhysX caps a hull at 255 vertices by default
@@ -283,12 +284,12 @@ def cached_pieces(cache_dir: str | Path | None, kind: str, mesh: TriMesh, params
     path = Path(cache_dir) / key[:2] / f"{kind}-{key}.npz"
     if path.is_file():
         try:
-            with np.load(path) as z:
-                counts_v, counts_f = z["counts_v"], z["counts_f"]
-                vs = np.split(z["vertices"], np.cumsum(counts_v)[:-1]) if len(counts_v) else []
-                fs = np.split(z["faces"], np.cumsum(counts_f)[:-1]) if len(counts_f) else []
-                boxes = z["boxes"] if "boxes" in z.files else np.full((len(vs), 15), np.nan)
-                return [ConvexPiece(v, f, str(s), None if np.isnan(b).any() else b) for v, f, s, b in zip(vs, fs, z["sources"], boxes)]
+            z = load_npz(path)
+            counts_v, counts_f = z["counts_v"], z["counts_f"]
+            vs = np.split(z["vertices"], np.cumsum(counts_v)[:-1]) if len(counts_v) else []
+            fs = np.split(z["faces"], np.cumsum(counts_f)[:-1]) if len(counts_f) else []
+            boxes = z["boxes"] if "boxes" in z else np.full((len(vs), 15), np.nan)
+            return [ConvexPiece(v, f, str(s), None if np.isnan(b).any() else b) for v, f, s, b in zip(vs, fs, z["sources"], boxes)]
         except (OSError, ValueError, KeyError, zipfile.BadZipFile):
             pass  # unreadable: recompute below and overwrite
     pieces = compute()

@@ -12,6 +12,7 @@ from PIL import Image as PILImage
 
 from ..data.frames import Frame, ImageRef
 from ..errors import InputError
+from ..npyio import load_npy
 from .depth_bin import DepthBin
 
 
@@ -111,6 +112,13 @@ def read_rgb(ref: ImageRef) -> np.ndarray:
     return cv2.cvtColor(img, cv2.COLOR_BGR2RGB)
 
 
+def _npy(path: Path) -> np.ndarray:
+    try:
+        return load_npy(path)
+    except (OSError, ValueError) as exc:
+        raise InputError(path, f"not a readable .npy array ({exc})") from None
+
+
 def read_depth(ref: ImageRef, depth_scale: float = 0.001) -> np.ndarray:
     """Depth in metres, float32 (H, W), 0 where invalid."""
     if ref.kind in ("depth_bin_lz4", "depth_bin_deflate", "depth_bin_deflate_stream"):
@@ -118,7 +126,7 @@ def read_depth(ref: ImageRef, depth_scale: float = 0.001) -> np.ndarray:
     if not ref.path.is_file():
         raise InputError(ref.path, "depth file not found")
     if ref.kind == "npy":
-        d = np.load(ref.path, allow_pickle=False).astype(np.float32)
+        d = _npy(ref.path).astype(np.float32)
     else:
         d = cv2.imread(str(ref.path), cv2.IMREAD_UNCHANGED)
         if d is None:
@@ -133,7 +141,7 @@ def read_label_image(ref: ImageRef) -> np.ndarray:
     if not ref.path.is_file():
         raise InputError(ref.path, "label image not found")
     if ref.kind == "npy":
-        return np.load(ref.path, allow_pickle=False).astype(np.int32)
+        return _npy(ref.path).astype(np.int32)
     img = cv2.imread(str(ref.path), cv2.IMREAD_UNCHANGED)
     if img is None:
         raise InputError(ref.path, "cannot decode label image")
