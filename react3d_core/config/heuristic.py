@@ -331,6 +331,7 @@ class HandleConfig(StageConfig):
     aspect: float = Field(2.2, ge=1, description="Long side at least this times the short side.")
     min_fill: float = Field(0.4, ge=0, le=1, description="A handle blob fills at least this share of its box.")
     join_gap: float = Field(0.03, ge=0, description="Blob pieces this close along a row (m) are one handle (a bar broken by a highlight).")
+    mesh_bar_parts: bool = Field(True, description="A blob (colour and mesh protrusion joined) that is neither a bar nor a knob still yields each piece of it that the mesh's protrusion alone holds and that is a bar: a lip proud along a drawer's top edge joined the dark colour of its top face and the protrusion read along the proud drawer's side into a blob too thick for a handle (off: the blob is dropped whole).")
     min_seen_px: int = Field(100, ge=0, description="A plane with fewer seen orthophoto px has no handles.")
     background_win: float = Field(0.12, gt=0, description="Window of the local background — of the colour, and of the surface a handle in the mesh stands out from (m).")
     outline_margin: float = Field(0.02, ge=0, description="Colour blobs this close to the plane's outline are not handles (m).")
@@ -515,6 +516,7 @@ class PortholeConfig(StageConfig):
     inner_max: float = Field(0.1, ge=0, le=1, description="... is at most this share proud (the glass bowl is no surface; a round boss or a clock is a filled disc).")
     face_depth: tuple[float, float] = Field((-0.02, 0.12), description="Faces this far behind/in front of the plane are the door's (m): its ring and bowl stand up to 10 cm proud of the plate.")
     plate_gap: float = Field(0.15, ge=0, description="A front as wide as the door within this (m) above or below it is a strip of the appliance's plate (cut by the door's and the control panel's edges; the panel's knob may read as a handle), no front.")
+    bar_cuts: bool = Field(True, description="No cell cut runs through a porthole door's core (the lines holding at least half of its widest line: |offset| <= 0.87 of the radius): its glass bowl is a hole in the plate's coverage, and the splitter took the hole's side for the corner of an L-shaped outline and cut the plate, and the detergent drawer above the door, in two (off: portholes are found after the split and only replace the cells they cover).")
 
 
 class HeuristicConfig(StageConfig):

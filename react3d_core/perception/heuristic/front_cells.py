@@ -153,6 +153,40 @@ def off_threshold(diff: np.ndarray, valid: np.ndarray, cfg: HeuristicConfig) -> 
     return max(cfg.handles.contrast, cfg.image.texture_factor * float(np.median(diff[valid])))
 
 
+def _is_bar(w: int, h: int, area: int, res: float, p: HandleConfig) -> bool:
+    """A box ``w`` x ``h`` px holding ``area`` px is a bar handle's: its sides within ``p.length`` and
+    ``p.thickness``, ``p.aspect`` times longer than thick, ``p.min_fill`` of it filled."""
+    long_, short = max(w, h) * res, min(w, h) * res
+    return (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]
+            and max(w, h) >= p.aspect * min(w, h) and area >= p.min_fill * w * h)
+
+
+def _candidates(lab: np.ndarray, stats: np.ndarray, n: int, mesh_bars: np.ndarray | None, res: float,
+                p: HandleConfig, bars_only: bool):  # noqa: ANN202 - a generator of plain tuples
+    """Each blob of ``lab`` as (label, x, y, w, h, area, is_bar, is_knob). A blob that is neither, when
+    ``mesh_bars`` is given, yields instead each piece of it that ``mesh_bars`` (the mesh's protrusions)
+    holds on its own and that is a bar, relabelled in ``lab`` with a new label. Why: a lip standing proud
+    along a drawer's top edge is a plain bar in the mesh, but the colour above it (its top face, dark)
+    and the protrusion the local surface reads along the proud drawer's side joined it into a blob too
+    thick for a handle (washing machines' detergent drawers: none had a handle)."""
+    nxt = n
+    for j in range(1, n):
+        x, y, w, h, area = (int(v) for v in stats[j])
+        bar = _is_bar(w, h, area, res, p)
+        knob = not bar and not bars_only and p.knobs and _is_knob(w, h, area, res, p)
+        if bar or knob or mesh_bars is None:
+            yield j, x, y, w, h, area, bar, knob
+            continue
+        part = (mesh_bars[y:y + h, x:x + w] & (lab[y:y + h, x:x + w] == j)).astype(np.uint8)
+        m, sub, st, _ = cv2.connectedComponentsWithStats(part, connectivity=CONNECTIVITY)
+        for k in range(1, m):
+            a, b, ww, hh, ar = (int(v) for v in st[k])
+            if _is_bar(ww, hh, ar, res, p):
+                lab[y:y + h, x:x + w][sub == k] = nxt
+                yield nxt, x + a, y + b, ww, hh, ar, True, False
+                nxt += 1
+
+
 def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff: np.ndarray | None = None,
                  protrusion: np.ndarray | None = None, outline: np.ndarray | None = None,
                  bars_only: bool = False, lone: list[Handle] | None = None) -> list[Handle]:
@@ -186,14 +220,10 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     g = max(MIN_KERNEL, int(p.join_gap / o.res) | 1)  # a bar broken by a highlight is one handle
     blob = cv2.morphologyEx(blob, cv2.MORPH_CLOSE, np.ones((1, g), np.uint8))
     n, lab, stats, _ = cv2.connectedComponentsWithStats(blob, connectivity=CONNECTIVITY)
+    mesh_bars = bar & keep if p.mesh_bar_parts else None
     out = []
     seams = hidden = None
-    for j in range(1, n):
-        x, y, w, h, area = stats[j]
-        long_, short = max(w, h) * o.res, min(w, h) * o.res
-        bar = (p.length[0] <= long_ <= p.length[1] and p.thickness[0] <= short <= p.thickness[1]
-               and max(w, h) >= p.aspect * min(w, h) and area >= p.min_fill * w * h)
-        knob = not bar and not bars_only and p.knobs and _is_knob(w, h, area, o.res, p)
+    for j, x, y, w, h, area, bar, knob in _candidates(lab, stats, n, mesh_bars, o.res, p, bars_only):
         if not (bar or knob):
             continue
         if p.seam_share > 0:
@@ -367,7 +397,7 @@ def _side_cover(ref: np.ndarray, box: tuple[int, int, int, int], pad: int, gap: 
 
 def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg: HeuristicConfig,
                 lines: tuple[np.ndarray, np.ndarray] | None = None, lone: list[Handle] = (),
-                panes: np.ndarray | None = None) -> list[Cell]:
+                panes: np.ndarray | None = None, barred: Sequence[tuple[int, int, int, int]] = ()) -> list[Cell]:
     """Guillotine partition of the plane's covered area at spanning seams, then between handle pairs.
     ``lines``: pixels on vertical and on horizontal lines that learned line segments of several views
     support (line_evidence.py; ``perception.heuristic.lines``), a seam where the brightness shows none.
@@ -375,7 +405,8 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
     (a chest's wide top drawer has one knob in its middle, over the seam between the two drawers of each
     row below; the seam's line ran on up through the knob and halved the top drawer).
     ``panes``: the plane's glass panes (``image_fronts.framed_panes``); with ``cells.pane_margin`` > 0 no cut
-    runs through a pane or within that margin of it."""
+    runs through a pane or within that margin of it. ``barred``: more boxes (c0, r0, c1, r1; grid px, end
+    exclusive) no cut runs through, as it runs through no pane: porthole doors' cores."""
     rows, cols = np.nonzero(coverage)
     if not len(rows):
         return []
@@ -413,7 +444,7 @@ def split_cells(o: Orthophoto, coverage: np.ndarray, handles: list[Handle], cfg:
                 along_c[h.box[0]:h.box[2]] = True
         learned = LearnedLines(lines[0], lines[1], cfg.lines.span, along_c, along_r)
     boxes = (pane_boxes(panes, int(round(cells_cfg.pane_margin / o.res)))
-             if panes is not None and cells_cfg.pane_margin > 0 else [])
+             if panes is not None and cells_cfg.pane_margin > 0 else []) + list(barred)
     cells = _split(root, vert, horiz, coverage, p, cells_cfg, min_px, 0, blocked_c, blocked_r, handles, gs, cols, learned,
                    int(cells_cfg.edge_strip / o.res), pull_px, boxes)
     if pair_px:

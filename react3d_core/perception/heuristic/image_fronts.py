@@ -32,7 +32,7 @@ from .orthophoto import ColourCalibration, Orthophoto, build_orthophotos
 from .constants import CONNECTIVITY, MIN_KERNEL, NEIGHBOURS, XYZ
 from .plane_surface import PlaneSurface, cast_surface, flat_surface
 from .planes import Plane, share_behind, vertical_planes
-from .portholes import find_portholes
+from .portholes import find_portholes, porthole_core
 
 _MIN_CUT_SIDES = 2  # a handle-less cell cut out on this many sides is cut out by the plane's seams
 _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a third of the window's blocks
@@ -620,8 +620,15 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         p = o.plane
         rel = centroids - p.n * p.d
         in_plane = np.stack([rel @ p.u, centroids[:, 2], rel @ p.n], 1)  # (u, z, depth) of every face, once per plane
+        ports: list[tuple[int, int, int, int]] = []
+        if cfg.portholes.enabled:
+            # the ring stands out of the plate's plane, not of the surface around it (the ring itself)
+            proud = bars if win == 0.0 else (
+                protrusion_map(o, surf, hc, 0.0, cfg.planes.offset_tol) if rays
+                else protrusion_from_faces(o, centroids, mesh.face_normals, hc, 0.0, cfg.planes.offset_tol))
+            ports = find_portholes(proud, o.res, cfg.portholes)
         cells = split_cells(o, cov, handles, cfg, supports[i].lines(cfg.lines.min_views) if supports else None, lone,
-                            panes)
+                            panes, [porthole_core(b) for b in ports] if cfg.portholes.bar_cuts else ())
         tiled = is_tiled(cells, cov, o.res, cfg.cells)
         mine: list[Front] = []
         for cell in cells:
@@ -640,19 +647,14 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         if (not tiled and not o.plane.averaged and piece_of_fronts(mine, o, cov, cfg)
                 and (not cfg.cells.piece_behind or stands_in_room(mesh, o.plane, cfg.room_wall))):
             pieces.update(id(f) for f in mine)
-        if cfg.portholes.enabled:
-            # the ring stands out of the plate's plane, not of the surface around it (the ring itself)
-            proud = bars if win == 0.0 else (
-                protrusion_map(o, surf, hc, 0.0, cfg.planes.offset_tol) if rays
-                else protrusion_from_faces(o, centroids, mesh.face_normals, hc, 0.0, cfg.planes.offset_tol))
-            for box in find_portholes(proud, o.res, cfg.portholes):
-                door = _box_front(o, box, in_plane, cfg.portholes.face_depth, cfg.image.min_faces)
-                if door is None:
-                    continue
-                mine = [f for f in mine if _overlap(f, door) < _PORTHOLE_COVERED * door.w * door.h
-                        and not _plate_strip(f, door, cfg.portholes.plate_gap)]
-                mine.append(door)
-                round_doors.add(id(door))
+        for box in ports:
+            door = _box_front(o, box, in_plane, cfg.portholes.face_depth, cfg.image.min_faces)
+            if door is None:
+                continue
+            mine = [f for f in mine if _overlap(f, door) < _PORTHOLE_COVERED * door.w * door.h
+                    and not _plate_strip(f, door, cfg.portholes.plate_gap)]
+            mine.append(door)
+            round_doors.add(id(door))
         fronts += mine
     if not cfg.cells.single_cut:
         fronts = [f for f in fronts if id(f) not in singles or id(f) in pieces]
@@ -979,10 +981,12 @@ def _overlap(f: Front, g: Front) -> float:
 
 
 def _plate_strip(f: Front, door: Front, gap: float) -> bool:
-    """``f`` is a strip of the plate around porthole ``door``: at least as wide as the door (``_PORTHOLE_SPAN``
-    of it), within ``gap`` above or below it. A drawer beside the porthole (detergent) is narrower; the
-    plate's strips between seams and the control panel are not fronts, whatever its knob and the drawer's
-    edge read as (a handle: free-standing tuning 311)."""
+    """``f`` is a strip of the plate around porthole ``door``: within ``gap`` above or below it, and at least
+    as wide as the door (``_PORTHOLE_SPAN`` of it) or, over the door's columns, with no handle. A drawer
+    beside the porthole (detergent) is narrower and has its grip; the plate's strips between seams and the
+    control panel are not fronts, whatever its knob and the drawer's edge read as (a handle: free-standing
+    tuning 311), and the panel beside the drawer, cut from it at the drawer's side, has no handle."""
     span = u_overlap(door, f)
     apart = max(f.extent_v[0] - door.extent_v[1], door.extent_v[0] - f.extent_v[1])
-    return span >= _PORTHOLE_SPAN * door.w and -_PORTHOLE_SPAN * door.h < apart <= gap
+    plain = f.handle_points is None or not len(f.handle_points)
+    return (span >= _PORTHOLE_SPAN * door.w or (plain and span > 0)) and -_PORTHOLE_SPAN * door.h < apart <= gap

@@ -17,6 +17,7 @@ from .constants import CONNECTIVITY
 
 _SECTORS = 24  # angular sectors the ring's pixels must reach round its centre
 _QUARTER = 0.25  # the radius is a quarter of the box's width plus height (their mean half)
+_CORE = 1.0 - np.sqrt(3.0) / 2.0  # a disc's lines at most 0.87 r off its centre hold half its widest line
 
 
 def find_portholes(proud: np.ndarray, res: float, cfg: PortholeConfig) -> list[tuple[int, int, int, int]]:
@@ -49,3 +50,14 @@ def find_portholes(proud: np.ndarray, res: float, cfg: PortholeConfig) -> list[t
             continue
         out.append((r0, r0 + h, c0, c0 + w))
     return out
+
+
+def porthole_core(box: tuple[int, int, int, int]) -> tuple[int, int, int, int]:
+    """The core of porthole ``box`` (r0, r1, c0, c1) as a box (c0, r0, c1, r1) of ``front_cells.pane_boxes``:
+    the disc's rows and columns holding at least half of its widest line, as a pane's core. Why the core and
+    not the box: the door's own outline is a seam the splitter must still cut (the plate above it, the
+    detergent drawer's bottom edge), and near the box's edge the disc is narrower than that seam's gap."""
+    r0, r1, c0, c1 = box
+    rad = _QUARTER * ((r1 - r0) + (c1 - c0))
+    k = int(np.ceil(_CORE * rad))
+    return c0 + k, r0 + k, max(c0 + k, c1 - k), max(r0 + k, r1 - k)

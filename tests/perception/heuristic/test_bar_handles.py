@@ -107,3 +107,31 @@ def test_a_shaded_stile_cuts_an_oven_door_unless_one_bar_outranks_it() -> None:
     one = find_handles(o, cov, one_bar, protrusion=bars)
     assert [h.box[:2] for h in one] == [(21, 30)]
     assert len(split_cells(o, cov, one, one_bar)) == 1
+
+
+def _detergent_drawer() -> tuple[np.ndarray, np.ndarray]:
+    """A white plate 0.6 x 0.4 m (150 x 100 px): a drawer's lip, a bar 12.4 x 2.4 cm in the scan (rows 40-45,
+    cols 30-60), the dark colour of its top face right above it (rows 34-39, cols 26-64), and the protrusion
+    the local surface reads along the proud drawer's side and bottom corner 3 px right of the lip (rows
+    40-75, cols 64-71, and rows 70-75, cols 50-71: an L 8.8 x 14.4 cm, as on a scanned washing machine).
+    Joined by the blob's row closing, lip, top face and L make one blob 46 x 42 px: no bar, no knob."""
+    rng = np.random.default_rng(7)
+    img = np.full((100, 150, 3), 0.9, np.float32) + rng.normal(0, 0.003, (100, 150, 3)).astype(np.float32)
+    bars = np.zeros((100, 150), bool)
+    img[34:40, 26:65] = 0.2
+    img[40:46, 30:61] = 0.5
+    bars[40:46, 30:61] = True
+    bars[40:76, 64:72] = True
+    bars[70:76, 50:72] = True
+    return img, bars
+
+
+def test_a_mesh_bar_joined_to_other_blobs_is_still_a_handle() -> None:
+    cfg = HeuristicConfig()
+    img, bars = _detergent_drawer()
+    o, cov = flat_ortho(img), np.ones(bars.shape, bool)
+    off = cfg.model_copy(update={"handles": cfg.handles.model_copy(update={"mesh_bar_parts": False})})
+    assert find_handles(o, cov, off, protrusion=bars) == []
+    hs = find_handles(o, cov, cfg, protrusion=bars)
+    assert [(h.box, h.horizontal, h.knob) for h in hs] == [((30, 40, 61, 46), True, False)]
+    assert len(hs[0].pixels) == 6 * 31  # the lip's own pixels, not the top face's or the L's

@@ -8,6 +8,7 @@ import numpy as np
 from react3d_core.config.heuristic import HeuristicConfig
 from react3d_core.perception.heuristic.front_cells import Cell, _pane_blocks, pane_boxes, split_cells
 from react3d_core.perception.heuristic.image_fronts import seen_rim
+from react3d_core.perception.heuristic.portholes import porthole_core
 
 from tests.perception.heuristic.flat_orthos import flat_ortho
 
@@ -82,3 +83,42 @@ def test_seen_rim_takes_the_side_edges_with_sides():
     assert both[:, 5:8].all() and both[:, 32:35].all()  # the outer stiles, 3 px wide
     assert both.sum() == 2 * 3 * 30 + 2 * 3 * 44  # ... on the 44 rows between the top and bottom rims
     assert not both[10:40, 8:32].any()
+
+
+def test_porthole_core_is_the_discs_lines_holding_half_its_widest_line():
+    # r = (120 + 120) / 4 = 60; lines within 0.866 r of the centre: ceil(0.134 * 60) = 9 px in from each side
+    assert porthole_core((0, 120, 0, 120)) == (9, 9, 111, 111)
+    # rows 10-110, cols 20-130: r = (100 + 110) / 4 = 52.5, ceil(0.134 * 52.5) = ceil(7.03) = 8
+    assert porthole_core((10, 110, 20, 130)) == (28, 18, 122, 102)
+
+
+def washing_machine_plate() -> tuple[np.ndarray, np.ndarray, tuple[int, int, int, int]]:
+    """A 0.6 x 0.85 m white plate (150 x 212 px): a porthole whose ring and glass are a hole in the coverage
+    (radius 55 px, centre row 120, col 75; the ring's box rows 65-176, cols 20-131), the control panel's
+    lower edge a dark line across the plate at row 55, and a detergent drawer top left (cols 0-51, rows 0-44)
+    outlined by 1 px dark gaps. Returns the image, the coverage and the ring's box."""
+    rng = np.random.default_rng(5)
+    img = np.full((212, 150, 3), 0.85, np.float32) + rng.normal(0, 0.003, (212, 150, 3)).astype(np.float32)
+    img[55, :] = 0.4
+    img[45, 0:53] = 0.4
+    img[0:46, 52] = 0.4
+    yy, xx = np.mgrid[0:212, 0:150]
+    cov = np.hypot(yy - 120, xx - 75) > 55
+    return img, cov, (65, 176, 20, 131)
+
+
+def test_no_cut_runs_through_a_porthole_and_the_drawer_above_it_is_cut_out():
+    cfg = HeuristicConfig()
+    img, cov, ring = washing_machine_plate()
+    o = flat_ortho(img)
+    core = porthole_core(ring)  # (c0, r0, c1, r1) = (28, 73, 123, 168)
+
+    def through_core(cells: list[Cell]) -> list[tuple[int, int, int, int]]:
+        return [(c.r0, c.r1, c.c0, c.c1) for c in cells
+                if c.r0 < core[3] and c.r1 > core[1] and (core[0] < c.c0 < core[2] or core[0] < c.c1 < core[2])]
+
+    assert through_core(split_cells(o, cov, [], cfg))  # the glass's hole reads as an outline's corner
+    cells = split_cells(o, cov, [], cfg, barred=[core])
+    assert not through_core(cells)
+    # the drawer's cell ends at its right gap; its bottom gap is under cells.min_side from the door's top
+    assert [(c.r0, c.c0, c.c1) for c in cells if c.r0 == 0 and c.c0 == 0] == [(0, 0, 52)]

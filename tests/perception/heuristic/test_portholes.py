@@ -80,13 +80,16 @@ def test_the_plate_strips_over_a_porthole_go_and_a_detergent_drawer_beside_it_st
     """A washing machine 0.6 m wide, its door box 0.08-0.52 x 0.16-0.60: the plate's strip right above the
     door (0.61-0.70) and the control strip over it (0.70-0.84, 0.1 m above the door: within plate_gap 0.15)
     span the door's width: plate, with or without a "handle" (its knob, the drawer's edge). The detergent
-    drawer (0-0.2 wide) is narrower; a strip 0.3 m above is beyond the gap. The cell covering the whole plate
-    overlaps the door by all of its area (0.44 x 0.44 m)."""
+    drawer (0-0.2 wide, its grip a handle) is narrower; the control panel beside it (0.2-0.6, over the door's
+    columns 0.2-0.52) has no handle: plate. A plain front as narrow beside the door's columns (0.53-0.6) is no
+    strip of it, nor is a strip 0.3 m above (beyond the gap). The cell covering the whole plate overlaps the
+    door by all of its area (0.44 x 0.44 m)."""
     door = _front(0.08, 0.52, 0.16, 0.60)
     gap = PortholeConfig().plate_gap
     assert _plate_strip(_front(0.0, 0.6, 0.61, 0.70), door, gap)
     assert _plate_strip(_front(0.0, 0.6, 0.70, 0.84), door, gap)
-    assert not _plate_strip(_front(0.0, 0.2, 0.70, 0.84), door, gap)
+    assert _plate_strip(_front(0.2, 0.6, 0.70, 0.84), door, gap)
+    assert not _plate_strip(_front(0.53, 0.6, 0.70, 0.84), door, gap)
     assert not _plate_strip(_front(0.0, 0.6, 0.90, 1.10), door, gap)
     assert _plate_strip(_front(0.0, 0.6, 0.70, 0.84, handle=True), door, gap)
     assert not _plate_strip(_front(0.0, 0.2, 0.70, 0.84, handle=True), door, gap)
