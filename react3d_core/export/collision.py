@@ -22,8 +22,8 @@ import numpy as np
 import trimesh
 
 from ..atomic import atomic_path
-from ..npyio import load_npz
 from ..data.mesh import TriMesh
+from ..npyio import load_npz
 
 MAX_HULL_VERTICES = 200  # PhysX caps a hull at 255 vertices by default
 

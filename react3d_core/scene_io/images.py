@@ -113,6 +113,7 @@ def read_rgb(ref: ImageRef) -> np.ndarray:
 
 
 def _npy(path: Path) -> np.ndarray:
+    """The array in an input ``.npy`` file; a bad one is an ``InputError`` naming it, not numpy's traceback."""
     try:
         return load_npy(path)
     except (OSError, ValueError) as exc:
