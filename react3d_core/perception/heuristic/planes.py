@@ -31,6 +31,7 @@ _PIECE_CLOSE = np.ones((3, 3))  # grid cells touching across one empty cell (or 
 _SAMPLES_PER_CELL = 2  # faces are sampled at this many points per piece-grid cell along their edges
 _LATTICE_MAX = 64  # ... at most this many steps along a face's longest edge
 _CORNERS = 3  # a triangle's vertices (and barycentric coordinates)
+_KEY_STRIDE = 1 << 32  # a grid cell's key: its u index times this plus its v index (v indices stay far below)
 _CENTROID = np.full((1, _CORNERS), 1.0 / _CORNERS)  # barycentric coordinates of a triangle's centroid
 
 
@@ -47,6 +48,7 @@ class Plane:
     extent_v: tuple[float, float]
     area: float
     averaged: bool = False  # found only by normals averaged over neighbouring faces (the last vote)
+    residual: bool = False  # found by the faces no offset peak took (a front set back beside a larger one)
 
     def to_world(self, uu: np.ndarray, vv: np.ndarray, depth: float = 0.0) -> np.ndarray:
         """Points at in-plane coordinates (uu, vv=z), ``depth`` in front of the plane."""
@@ -120,6 +122,8 @@ def vertical_planes(mesh: TriMesh, cam_center: np.ndarray, cfg: PlanesConfig, *,
         for p in more:
             p.averaged = True
         planes += more
+    if any(p.residual for p in planes):
+        planes = _unstacked(planes, samples, cfg)
     signs = outward_signs(planes, nrm, area, cam_center, view_dirs, cfg.normal_agree)
     out = [p if sg > 0 else _flip(p) for p, sg in zip(planes, signs)]
     out.sort(key=lambda p: -p.area)
@@ -237,37 +241,111 @@ def _vote(cand: np.ndarray, theta: np.ndarray, area: np.ndarray, cen: np.ndarray
         oh = ndimage.uniform_filter1d(oh, max(1, int(offset_tol / ob)), mode="constant")
         idx_near = np.flatnonzero(near)
         used = np.zeros(len(cen), bool)  # a refitted plane may reach faces of the next offset peak
-        for pk in _peaks(oh, min_area / cfg.offset_peak_div, int(2 * offset_tol / ob), circular=False):
-            d0 = lo + (pk + 0.5) * ob
-            sel = idx_near[np.abs(off - d0) <= offset_tol]
-            if area[sel].sum() < min_area:
-                continue
-            n_fit = nd
-            if refit_deg > 0:  # the face positions fix a wide plane's direction better than its (noisy, skewed) normals
-                xy, w = samples.of(sel)
-                n_fit, d_fit = fit_direction(xy[:, :2], w, nd, cfg)
-                refit = None
-                if n_fit is not nd:
-                    refit = idx_near[(np.abs(cen[idx_near] @ n_fit - d_fit) <= offset_tol) & ~used[idx_near]]
-                # straightened, the plane keeps (nearly) all it had; turned onto another surface, it does not
-                if (refit is not None
-                        and area[np.intersect1d(refit, sel, assume_unique=True)].sum() >= cfg.refit_keep_share * area[sel].sum()):
-                    sel = refit
-                else:
-                    n_fit = nd
-                    sel = sel[~used[sel]]
-                if area[sel].sum() < min_area:
-                    continue
-                used[sel] = True
-            for p in _pieces(sel, samples, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])), cfg.cell,
-                             min_area):
-                if cfg.max_skew_deg > 0 and is_slice(p, theta, area, cen, cfg.max_skew_deg):
-                    continue
-                planes.append(p)
-                voted.add(float(peak))
+        first = _peaks(oh, min_area / cfg.offset_peak_div, int(2 * offset_tol / ob), circular=False)
+        firsts: list[Plane] = []
+        for pk in first:
+            firsts += _take(lo + (pk + 0.5) * ob, idx_near, off, nd, used, cen, area, samples, cfg, min_area, theta)
+        planes += firsts
+        if firsts:
+            voted.add(float(peak))
+        if cfg.residual_dip > 0 and first:
+            # a small front a few cm behind a large one (a microwave on its cabinet) peaks within the large
+            # one's separation, on its flank: the faces no peak took vote again, and a peak of theirs from
+            # which all faces' offsets dip on the way to the nearest peak taken is a plane (a wall's tail,
+            # or a bent wall's plateau, has no such dip)
+            d_first = lo + (np.array(first) + 0.5) * ob
+            rest = ~used[idx_near] & (np.abs(off[:, None] - d_first[None]).min(1) > offset_tol)
+            if rest.any():
+                rh = np.bincount(((off[rest] - lo) / ob).astype(int), weights=area[idx_near[rest]], minlength=nb)
+                rh = ndimage.uniform_filter1d(rh, max(1, int(offset_tol / ob)), mode="constant")
+                for pk in _peaks(rh, min_area / cfg.offset_peak_div, int(2 * offset_tol / ob), circular=False):
+                    f = min(first, key=lambda q: abs(q - pk))
+                    between = oh[min(pk, f) + 1:max(pk, f)]
+                    if not len(between) or between.min() > cfg.residual_dip * oh[pk]:
+                        continue
+                    for p in _take(lo + (pk + 0.5) * ob, idx_near[rest], off[rest], nd, used, cen, area, samples, cfg,
+                                   min_area, theta):
+                        p.residual = True
+                        planes.append(p)
     # the directions voted for, not the planes' own: a small plane refit a few degrees off its peak (a
     # wall's strip behind a turned chest, 4 degrees off) would bar the direction the next vote needs
     return planes, sorted(voted)
+
+
+def _take(d0: float, idx: np.ndarray, off: np.ndarray, nd: np.ndarray, used: np.ndarray, cen: np.ndarray,
+          area: np.ndarray, samples: _Samples, cfg: PlanesConfig, min_area: float, theta: np.ndarray,
+          ) -> list[Plane]:
+    """The plane at offset ``d0`` along ``nd`` of the faces ``idx`` (offsets ``off``), refit when its faces'
+    positions fix its direction better: its pieces of at least ``min_area`` that are no slice."""
+    offset_tol = cfg.offset_tol
+    sel = idx[np.abs(off - d0) <= offset_tol]
+    if area[sel].sum() < min_area:
+        return []
+    n_fit = nd
+    if cfg.refit_deg > 0:  # the face positions fix a wide plane's direction better than its (noisy, skewed) normals
+        xy, w = samples.of(sel)
+        n_fit, d_fit = fit_direction(xy[:, :2], w, nd, cfg)
+        refit = None
+        if n_fit is not nd:
+            refit = idx[(np.abs(cen[idx] @ n_fit - d_fit) <= offset_tol) & ~used[idx]]
+        # straightened, the plane keeps (nearly) all it had; turned onto another surface, it does not
+        if (refit is not None
+                and area[np.intersect1d(refit, sel, assume_unique=True)].sum() >= cfg.refit_keep_share * area[sel].sum()):
+            sel = refit
+        else:
+            n_fit = nd
+            sel = sel[~used[sel]]
+        if area[sel].sum() < min_area:
+            return []
+        used[sel] = True
+    return [p for p in _pieces(sel, samples, area, n_fit, float(np.average(cen[sel] @ n_fit, weights=area[sel])),
+                               cfg.cell, min_area)
+            if not (cfg.max_skew_deg > 0 and is_slice(p, theta, area, cen, cfg.max_skew_deg))]
+
+
+def _unstacked(planes: list[Plane], samples: _Samples, cfg: PlanesConfig) -> list[Plane]:
+    """``planes`` less the residual ones stacked on another's footprint: a front's frame or panel, the plinth
+    behind its fronts, a TSDF scan's doubled surface are relief on one front; a microwave set back on its
+    cabinet stands beside the cabinet's front, not on it."""
+    cos_tol = np.cos(np.radians(cfg.angle_tol_deg))
+    main = [q for q in planes if not q.residual]
+    out = []
+    for p in planes:
+        if p.residual:
+            mid = p.to_world(np.mean(p.extent_u), np.mean(p.extent_v))
+            aligned = [q for q in main if abs(q.n @ p.n) >= cos_tol]
+            # within the offset tolerance of a plane it overlaps, it is that plane's surface (cut off it by the
+            # direction the larger one was refit on)
+            if any(abs(mid @ q.n - q.d) <= cfg.offset_tol and _overlap(p, q, cfg.cell) for q in aligned):
+                continue
+            close = [q.faces for q in aligned if abs(mid @ q.n - q.d) <= cfg.residual_stack_depth]
+            if close and layer_share(p, np.concatenate(close), samples, cfg.cell) > cfg.residual_max_stack:
+                continue
+        out.append(p)
+    return out
+
+
+def _overlap(p: Plane, q: Plane, grow: float) -> bool:
+    """Do the extents of the planes ``p`` and ``q`` (alike in direction) overlap, ``q``'s grown by ``grow``?"""
+    ends = p.to_world(np.array(p.extent_u), np.full(2, np.mean(p.extent_v))) @ q.u
+    return bool(ends.max() >= q.extent_u[0] - grow and ends.min() <= q.extent_u[1] + grow
+                and p.extent_v[1] >= q.extent_v[0] - grow and p.extent_v[0] <= q.extent_v[1] + grow)
+
+
+def layer_share(p: Plane, others: np.ndarray, samples: _Samples, cell: float) -> float:
+    """Share of the plane piece's grid cells (``cell`` m, in its own u, v) that the faces ``others`` also
+    occupy: a piece stacked on another's footprint (a front's frame, a door's panel, a plinth behind its
+    fronts) rather than beside it."""
+    own, _ = samples.with_face(p.faces)
+    oth, _ = samples.with_face(others)
+    if not len(own) or not len(oth):
+        return 0.0
+    def keys(pts: np.ndarray) -> np.ndarray:
+        iu = np.floor(pts @ p.u / cell).astype(np.int64)
+        iv = np.floor(pts[:, 2] / cell).astype(np.int64)
+        return iu * _KEY_STRIDE + iv
+    mine = np.unique(keys(own))
+    return float(np.isin(mine, keys(oth)).mean())
 
 
 def is_slice(p: Plane, theta: np.ndarray, area: np.ndarray, cen: np.ndarray, max_turn_deg: float) -> bool:
@@ -397,7 +475,7 @@ def _longest_run(t: np.ndarray, step: float) -> float:
 
 def _flip(p: Plane) -> Plane:
     u = horizontal_right(-p.n)
-    return Plane(-p.n, u, -p.d, p.faces, (-p.extent_u[1], -p.extent_u[0]), p.extent_v, p.area, p.averaged)
+    return Plane(-p.n, u, -p.d, p.faces, (-p.extent_u[1], -p.extent_u[0]), p.extent_v, p.area, p.averaged, p.residual)
 
 
 def _pieces(sel: np.ndarray, samples: _Samples, area: np.ndarray, n: np.ndarray, d: float, cell: float,
