@@ -211,7 +211,7 @@ def _vote(cand: np.ndarray, theta: np.ndarray, area: np.ndarray, cen: np.ndarray
     Direction peaks closer than ``direction_min_sep_bins`` to one of ``found`` are not taken. A piece that is
     a slice through a surface standing at another angle (``is_slice``: a turned cabinet's front cut along
     a wall's direction) is left out, and its faces stay free for the next vote."""
-    angle_tol_deg, offset_tol, refit_deg = cfg.angle_tol_deg, cfg.offset_tol, cfg.refit_deg
+    angle_tol_deg, offset_tol = cfg.angle_tol_deg, cfg.offset_tol
     if not cand.any():
         return [], []
     bins = np.floor(theta).astype(int) % _HALF_TURN_BINS
