@@ -19,6 +19,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import NamedTuple
 
 import cv2
 import numpy as np
@@ -30,7 +31,9 @@ from ..data.mesh import TriMesh
 from ..raster import Rasterizer
 
 _UP = np.array([0.0, 0.0, 1.0])
-COMPLETION_VERSION = "2"  # what a completed mesh in the cache was made by
+_VERTICAL_NZ = 0.3  # a face is vertical (a wall's) when its normal's vertical part is under this
+_AXIS_REFINE_DEG = 2.0  # the walls' azimuth: the area-weighted mean of the faces this close to the histogram's peak
+COMPLETION_VERSION = "3"  # what a completed mesh in the cache was made by
 
 
 @dataclass
@@ -171,17 +174,29 @@ def _pieces(mesh: TriMesh) -> np.ndarray:
     return connected_components(coo_matrix((np.ones(len(rows), np.int8), (rows, cols)), shape=(n, n)), directed=False)[1]
 
 
+class FittedPlane(NamedTuple):
+    """A vertical plane through scan returns: ``point``, unit ``normal`` towards the cameras, the ``inliers``
+    (indices into the returns) and whether they are a ``line`` (spread across only, not up)."""
+
+    point: np.ndarray
+    normal: np.ndarray
+    inliers: np.ndarray
+    line: bool = False
+
+
 def fit_vertical_planes(pts: np.ndarray, cameras: np.ndarray, cfg: MissedSurfaceConfig, rng: np.random.Generator,
-                        need: int, tol: float) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+                        need: int, tol: float, axis_deg: float | None = None) -> list[FittedPlane]:
     """Vertical planes through scan returns (RANSAC: two nearby returns and the vertical fix a plane; the
-    returns' own normals are no help, a few-triangle island has any), oriented towards the cameras:
-    ``(point, normal, inlier indices)`` while a plane gathers ``need`` returns within ``tol`` m. A plane
-    most cameras stand behind, or whose inliers do not spread over ``cfg.min_spread_m`` both across and
-    up, is not a surface seen and is skipped."""
+    returns' own normals are no help, a few-triangle island has any), oriented towards the cameras, while a
+    plane gathers ``need`` returns within ``tol`` m. A plane most cameras stand behind, or whose inliers do
+    not spread over ``cfg.min_spread_m`` both across and up, is not a surface seen and is skipped; unless
+    its inliers run at least ``cfg.min_line_m`` across (a horizontal line of returns: a dark base run's top
+    edge), is an edge (``_edge_line``) and runs along the room's axes (``axis_deg``, the walls' azimuth
+    modulo 90, within ``cfg.line_axis_deg``; None: not tested), which is kept as a ``line``."""
     from scipy.spatial import cKDTree
 
     todo = np.arange(len(pts))
-    out: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+    out: list[FittedPlane] = []
     cam_c = cameras.mean(0)
     while len(todo) >= need:
         P = pts[todo]
@@ -220,10 +235,58 @@ def fit_vertical_planes(pts: np.ndarray, cameras: np.ndarray, cfg: MissedSurface
         inl = _one_piece(P, np.abs((P - pb) @ nb) <= tol, nb, cfg.return_reach_m)
         u = np.cross(_UP, nb)
         span = np.percentile(np.stack([P[inl] @ u, P[inl, 2]], 1), [10, 90], axis=0)
-        if (np.einsum("ij,j->i", cameras - pb, nb) > 0).mean() >= cfg.min_camera_share and np.all(span[1] - span[0] >= cfg.min_spread_m):
-            out.append((pb, nb, todo[inl]))
+        spread = span[1] - span[0]
+        if (np.einsum("ij,j->i", cameras - pb, nb) > 0).mean() >= cfg.min_camera_share:
+            if np.all(spread >= cfg.min_spread_m):
+                out.append(FittedPlane(pb, nb, todo[inl]))
+            elif (cfg.min_line_m > 0 and spread[0] >= cfg.min_line_m and _on_axis(nb, axis_deg, cfg.line_axis_deg)
+                  and _edge_line(pts, P[inl], pb, nb, u, tol, cfg)):
+                out.append(FittedPlane(pb, nb, todo[inl], line=True))
         todo = todo[~inl]
     return out
+
+
+def _edge_line(pts: np.ndarray, line: np.ndarray, point: np.ndarray, normal: np.ndarray, u: np.ndarray, tol: float,
+               cfg: MissedSurfaceConfig) -> bool:
+    """Is a line of returns an edge, not a strip of a horizontal sheet of them: at most ``cfg.line_ahead_share``
+    as many returns lie from ``cfg.line_gap_m`` to ``cfg.line_clear_m`` in front of it (towards the cameras),
+    at its height and along its length? A vertical plane cuts a strip out of a dark worktop's or floor's
+    returns at any angle; a worktop's front edge has nothing in front of it. The gap: the densest strip the
+    plane's tolerance holds may lie a few centimetres behind the edge itself."""
+    sd = (pts - point) @ normal
+    a = line @ u
+    z = line[:, 2]
+    ahead = ((sd > cfg.line_gap_m) & (sd <= cfg.line_clear_m) & (pts[:, 2] >= z.min() - tol) & (pts[:, 2] <= z.max() + tol)
+             & (pts @ u >= a.min()) & (pts @ u <= a.max()))
+    if ahead.sum() > cfg.line_ahead_share * len(line):
+        return False
+    bins = np.floor((a - a.min()) / cfg.voxel_m).astype(int)  # a line is dense along its length: floor speckle is not
+    return bool(len(np.unique(bins)) >= cfg.line_fill * (bins.max() + 1))
+
+
+def room_axis_deg(mesh: TriMesh, pieces: np.ndarray, max_island_m2: float) -> float | None:
+    """Azimuth (degrees, modulo 90) of the room's walls: the peak of the area-weighted azimuths of the vertical
+    faces of the scan's large pieces (walls, scanned furniture); None without such faces."""
+    lab_area = np.bincount(pieces[mesh.faces[:, 0]], weights=mesh.face_areas, minlength=pieces.max() + 1)
+    n = mesh.face_normals
+    big = (lab_area[pieces[mesh.faces[:, 0]]] >= max_island_m2) & (np.abs(n[:, 2]) < _VERTICAL_NZ)
+    if not big.any():
+        return None
+    az = np.degrees(np.arctan2(n[big, 1], n[big, 0])) % 90.0
+    hist = np.bincount(np.floor(az).astype(int) % 90, weights=mesh.face_areas[big], minlength=90)
+    smooth = hist + np.roll(hist, 1) + np.roll(hist, -1)  # a wall at 0.5 degrees splits over two bins
+    peak = float(np.argmax(smooth)) + 0.5
+    d = (az - peak + 45.0) % 90.0 - 45.0  # signed, modulo 90
+    near = np.abs(d) <= _AXIS_REFINE_DEG
+    return float((peak + np.average(d[near], weights=mesh.face_areas[big][near])) % 90.0)
+
+
+def _on_axis(normal: np.ndarray, axis_deg: float | None, tol_deg: float) -> bool:
+    """Does a horizontal ``normal`` face along the room's axes (within ``tol_deg``); True when the axes are unknown."""
+    if axis_deg is None:
+        return True
+    d = (np.degrees(np.arctan2(normal[1], normal[0])) - axis_deg) % 90.0
+    return bool(min(d, 90.0 - d) <= tol_deg)
 
 
 def _one_piece(P: np.ndarray, inl: np.ndarray, normal: np.ndarray, gap: float) -> np.ndarray:
@@ -379,14 +442,15 @@ def missed_planes(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, cf
     rng = np.random.default_rng(cfg.seed)
     centres = lo + (np.argwhere(occ) + 0.5) * cfg.voxel_m
     out = []
-    for point, normal, inl in fit_vertical_planes(P, cams, cfg, rng, cfg.min_returns, cfg.plane_tol_m):
+    axis = room_axis_deg(mesh, pieces, cfg.max_island_m2) if cfg.min_line_m > 0 else None
+    for point, normal, inl, line in fit_vertical_planes(P, cams, cfg, rng, cfg.min_returns, cfg.plane_tol_m, axis):
         on = np.abs((centres - point) @ normal) <= cfg.voxel_m  # the volume's section through the plane
         if not on.any():
             continue
         plane = plane_cells(centres[on], point, normal, cfg)
         if plane is None:
             continue
-        plane = near_returns(plane, P[inl], cfg)
+        plane = near_returns(plane, P[inl], cfg, line=line)
         if plane is not None:
             plane.n_returns = len(inl)
             plane.returns = P[inl]
@@ -394,10 +458,13 @@ def missed_planes(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer, cf
     return out
 
 
-def near_returns(plane: MissedPlane, returns: np.ndarray, cfg: MissedSurfaceConfig) -> MissedPlane | None:
+def near_returns(plane: MissedPlane, returns: np.ndarray, cfg: MissedSurfaceConfig, line: bool = False) -> MissedPlane | None:
     """The plane's region kept within ``cfg.return_reach_m`` of its returns (a wall section behind a cabinet
     holds none), and None when the returns already cover more than ``cfg.max_scanned`` of it (a surface the
-    scan holds is not missed) or under ``cfg.min_area`` is left."""
+    scan holds is not missed) or under ``cfg.min_area`` is left.
+
+    A ``line`` of returns (a base run's top edge) says nothing about how far the surface reaches up or down:
+    its region is the pieces of the section its reach touches, within the reach across only."""
     h, w = plane.cells.shape
     c = np.floor(((returns - plane.point) @ plane.u - plane.u0) / plane.res).astype(int)
     r = np.floor((plane.v_top - returns[:, 2]) / plane.res).astype(int)
@@ -406,6 +473,11 @@ def near_returns(plane: MissedPlane, returns: np.ndarray, cfg: MissedSurfaceConf
     hits[r[ok], c[ok]] = 1
     k = 2 * int(round(cfg.return_reach_m / plane.res)) + 1
     reach = cv2.dilate(hits, cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (k, k))).astype(bool)
+    if line:
+        lab, _ = ndimage.label(plane.cells)
+        touched = np.unique(lab[reach & plane.cells])
+        columns = reach.any(0)
+        reach = np.isin(lab, touched[touched > 0]) & columns[None, :]
     cells = plane.cells & reach
     if cells.sum() * plane.res ** 2 < cfg.min_area:
         return None

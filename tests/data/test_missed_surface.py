@@ -38,10 +38,10 @@ def _box(lo, hi) -> trimesh.Trimesh:
     return trimesh.Trimesh(*trimesh.remesh.subdivide_to_size(b.vertices, b.faces, 0.03))
 
 
-def _scene():
+def _scene(top_edge_only: bool = False):
     """A closed room (floor, ceiling, walls; back wall (y = 2) and a black cabinet (x 0.5..1.3, y 1.4..2, z 0..0.8) whose front is at
     y = 1.4. The true scene renders the depth readings (none on the cabinet); the scan lacks the cabinet but
-    for a few front patches (its sparse returns)."""
+    for a few front patches (its sparse returns), or (``top_edge_only``) for its front's top 4 cm, a line."""
     floor = trimesh.util.concatenate([_box([-1, -1, -0.02], [3, 2, 0]), _box([-1, -1, 2.5], [3, 2, 2.52]),  # floor, ceiling
                                       _box([-1.02, -1, 0], [-1, 2, 2.5]), _box([3, -1, 0], [3.02, 2, 2.5]),
                                       _box([-1, -1.02, 0], [3, -1, 2.5])])  # side and front walls: a closed room
@@ -53,6 +53,8 @@ def _scene():
     front = np.isclose(cen[:, 1], 1.4)
     rng = np.random.default_rng(0)
     patch = front & (rng.random(len(cen)) < 0.08)  # ~8 % of the front returned depth
+    if top_edge_only:
+        patch = front & (cen[:, 2] > 0.76)
     scan = trimesh.util.concatenate([floor, wall, trimesh.Trimesh(cab.vertices, cab.faces[patch])])
     true_r = Rasterizer(TriMesh(true.vertices, true.faces))
     scan_mesh = TriMesh(scan.vertices, scan.faces)
@@ -98,6 +100,23 @@ def test_missed_plane_is_the_cabinet_front(corner):
     assert abs(abs(p.normal[1]) - 1) < 1e-6 and p.normal[1] < 0  # faces the cameras (-y)
     assert abs(p.point[1] - 1.4) < 0.015
     # its region spans the front (0.8 x 0.8 m) within about a voxel on each side
+    assert 0.45 < p.area < 0.9
+
+
+def test_a_line_of_returns_fixes_the_plane_of_the_front_below_it():
+    # the black cabinet returns only its front's top edge, a line 0.8 m long and 4 cm tall: too flat for a plane
+    # (min_spread_m up) without lines; as a line (min_line_m, the default) it fixes the front's plane, and the region reaches
+    # down the missed volume's section to the floor, not only return_reach_m from the line
+    mesh, r, views = _scene(top_edge_only=True)
+    assert missed_planes(mesh, [], r, MissedSurfaceConfig(min_line_m=0.0), views) == []  # off
+    cfg = MissedSurfaceConfig(min_line_m=0.3)
+    planes = missed_planes(mesh, [], r, cfg, views)
+    assert len(planes) == 1
+    p = planes[0]
+    assert p.normal[1] < -0.9999 and abs(p.point[1] - 1.4) < 0.01
+    rows = np.flatnonzero(p.cells.any(1))
+    z_top, z_bottom = p.v_top - rows[0] * p.res, p.v_top - (rows[-1] + 1) * p.res
+    assert z_top > 0.75 and z_bottom < 0.8 - cfg.return_reach_m - 0.2  # down to within 0.2 m of the floor
     assert 0.45 < p.area < 0.9
 
 
@@ -249,7 +268,7 @@ def test_a_worktop_sheet_leaves_only_the_front_returns():
     assert returns.sum() == 4 * len(front) and not returns[4 * len(front):].any()  # the front's chips come first
     planes = fit_vertical_planes(tm.vertices[returns], cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns,
                                  cfg.plane_tol_m)
-    point, normal, inl = planes[0]
+    point, normal, inl, _ = planes[0]
     assert normal[1] > 0.999 and abs(point[1] - 0.57) < 0.005 and len(inl) == 4 * len(front)
 
 
@@ -265,8 +284,61 @@ def test_columns_of_returns_make_one_plane():
     cfg = MissedSurfaceConfig(pair_reach_m=0.6)
     planes = fit_vertical_planes(P, cams, cfg, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m)
     assert len(planes) == 1
-    point, normal, inl = planes[0]
+    point, normal, inl, _ = planes[0]
     assert normal[1] < -0.9999 and abs(point[1] - 4.09) < 0.003 and len(inl) >= 595
     nearest = MissedSurfaceConfig()  # the default: nearest returns
     assert nearest.pair_reach_m == 0.0
     assert fit_vertical_planes(P, cams, nearest, np.random.default_rng(cfg.seed), cfg.min_returns, cfg.plane_tol_m) == []
+
+
+def _line_cfg() -> MissedSurfaceConfig:
+    return MissedSurfaceConfig(min_line_m=0.3)
+
+
+def test_a_dense_edge_line_is_a_line_and_floor_speckle_is_not():
+    # returns along y = 0.57 at z 0.88 over x 1..3 (a base run's top edge), 2 cm tall: a line when dense
+    # (a return in every 3 cm step), nothing when 20 speckles spread over the same 2 m (fill under 0.5)
+    rng = np.random.default_rng(1)
+    cams = np.array([[2.0, 3.0, 1.5]])
+    cfg = _line_cfg()
+
+    def edge(n):
+        return np.stack([rng.uniform(1.0, 3.0, n), 0.57 + rng.normal(0, 0.002, n), rng.uniform(0.87, 0.89, n)], 1)
+
+    planes = fit_vertical_planes(edge(400), cams, cfg, np.random.default_rng(0), cfg.min_returns, cfg.plane_tol_m, 0.0)
+    assert len(planes) == 1 and planes[0].line and abs(planes[0].point[1] - 0.57) < 0.005 and planes[0].normal[1] > 0.999
+    assert fit_vertical_planes(edge(400), cams, MissedSurfaceConfig(min_line_m=0.0), np.random.default_rng(0), 15, 0.015, 0.0) == []
+    assert fit_vertical_planes(edge(20), cams, cfg, np.random.default_rng(0), 15, 0.015, 0.0) == []
+    # the same line turned 20 degrees off the room's walls is no line
+    c, s_ = np.cos(np.radians(20)), np.sin(np.radians(20))
+    turned = edge(400) @ np.array([[c, s_, 0], [-s_, c, 0], [0, 0, 1]])
+    assert fit_vertical_planes(turned, cams, cfg, np.random.default_rng(0), 15, 0.015, 0.0) == []
+
+
+def test_strips_of_a_returns_sheet_are_no_lines_but_its_front_edge_may_be():
+    # a dark worktop returns chips all over it (z 0.9, y 0..0.6): any vertical plane holds a strip of them; a strip
+    # with returns more than line_gap_m in front of it is a piece of the sheet, so only lines at its front edge
+    # (within line_gap_m of y = 0.6) are kept
+    rng = np.random.default_rng(2)
+    sheet = np.stack([rng.uniform(1.0, 3.0, 3000), rng.uniform(0.0, 0.6, 3000), rng.normal(0.9, 0.002, 3000)], 1)
+    cfg = _line_cfg()
+    planes = fit_vertical_planes(sheet, np.array([[2.0, 3.0, 1.5]]), cfg, np.random.default_rng(0), 15, 0.015, 0.0)
+    assert all(p.line and p.point[1] > 0.6 - cfg.line_gap_m - 0.015 for p in planes)
+    assert len(planes) <= 2
+
+
+def test_room_axis_is_the_walls_azimuth():
+    # two walls of a room turned 30.3 degrees (faces facing 30.3 and 120.3 degrees) and a small chip facing 75:
+    # the axis is the walls' azimuth modulo 90
+    walls = trimesh.util.concatenate([_box([0, 0, 0], [4, 0.02, 2.5]), _box([0, 0, 0], [0.02, 3, 2.5])])
+    walls.apply_transform(trimesh.transformations.rotation_matrix(np.radians(30.3), [0, 0, 1]))
+    chip = _chip([1.0, 1.0, 1.0], [np.cos(np.radians(75)), np.sin(np.radians(75)), 0], 0.03)
+    m = trimesh.util.concatenate([walls, chip])
+    tm = TriMesh(m.vertices, m.faces)
+    from react3d_core.scene_io.missed_surface import _on_axis, _pieces, room_axis_deg
+    axis = room_axis_deg(tm, _pieces(tm), 0.1)
+    assert axis is not None and abs(axis - 30.3) < 0.01
+    assert _on_axis(np.array([np.cos(np.radians(-59.0)), np.sin(np.radians(-59.0)), 0]), 30.5, 5.0)  # 90 - 59 = 31
+    assert not _on_axis(np.array([np.cos(np.radians(40.0)), np.sin(np.radians(40.0)), 0]), 30.5, 5.0)
+    assert _on_axis(np.array([1.0, 0, 0]), None, 5.0)
+    assert room_axis_deg(TriMesh(chip.vertices, chip.faces), _pieces(TriMesh(chip.vertices, chip.faces)), 0.1) is None

@@ -533,6 +533,12 @@ DEFAULTS = {
     # fusion/clip.py MAX_POINTS; scene_io/selection.py COVERAGE_VOXEL_M
     "clip.ransac_max_points": 2000,
     "frames.coverage_voxel_m": 0.05,
+    "frames.missed_surface.min_line_m": 0.3,
+    "frames.missed_surface.line_clear_m": 0.1,
+    "frames.missed_surface.line_gap_m": 0.05,
+    "frames.missed_surface.line_fill": 0.5,
+    "frames.missed_surface.line_axis_deg": 5.0,
+    "frames.missed_surface.line_ahead_share": 0.2,
 }
 
 
