@@ -93,8 +93,10 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 48: no cut runs through a porthole door's core (portholes.bar_cuts); the bar pieces the mesh alone holds in a
 #     blob too thick for a handle are handles (handles.mesh_bar_parts: a detergent drawer's lip); a handle-less
 #     front over a porthole's columns within plate_gap is the plate (the control panel beside the drawer)
+# 49: a framed hole the scan holds a surface across, near the plane and facing out, is a solid panel, not glass
+#     (image.pane_solid_share): it counts as the plane's coverage, seen in its own colours, and bars no cut
 # (opt-in, off it changes nothing: the faces no offset peak took vote again, planes.residual_dip: a front set back
 # a few cm beside a larger one, a microwave on its cabinet)
-HEURISTIC_VERSION = "48"
+HEURISTIC_VERSION = "49"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -315,6 +315,8 @@ DEFAULTS = {
     "perception.heuristic.image.pane_min_area": 0.01,
     "perception.heuristic.image.pane_min_side": 0.1,
     "perception.heuristic.image.pane_min_fill": 0.8,
+    "perception.heuristic.image.pane_solid_share": 0.5,
+    "perception.heuristic.image.pane_solid_depth": 0.015,
     "perception.heuristic.image.pane_seen": True,
     "perception.heuristic.image.pane_seen_reach": 0.035,
     "perception.heuristic.image.pane_seen_max_cover": 0.9,

@@ -296,6 +296,37 @@ def framed_panes(cov: np.ndarray, res: float, frame: float, cover: float, min_ar
     return out
 
 
+def solid_panes(panes: np.ndarray, o: Orthophoto, mesh: TriMesh, depth: float, max_share: float
+                ) -> tuple[np.ndarray, np.ndarray]:
+    """``panes`` split into glass and solid panels: a pane whose area is at least ``max_share`` covered by
+    faces facing out of the plane within ``depth`` (m) of it (each face's area projected onto the plane,
+    counted where its centroid falls) is a solid panel, part of the front's surface.
+
+    Why: a raised-panel or shaker front's panel is ringed by bevels and a frame at another depth or tilt;
+    when its middle is not the plane's (tilted facets of a pyramid panel, an offset over the plane's
+    tolerance) it is a hole framed all round, as a glass pane is. Glass leaves no surface there (the views
+    see what lies behind it), a panel leaves it all; taken for glass, the panel blocked every cut through its
+    columns and a drawer bank stayed one cell. Summed projected areas read the same on fine and decimated
+    meshes."""
+    if not panes.any() or max_share >= 1.0:
+        return panes, np.zeros(panes.shape, bool)
+    n, lab = cv2.connectedComponents(panes.astype(np.uint8), connectivity=CONNECTIVITY)
+    p = o.plane
+    cen, nrm = mesh.face_centroids, mesh.face_normals
+    facing = nrm @ p.n
+    near = np.flatnonzero((np.abs(cen @ p.n - p.d) <= depth) & (facing > 0))
+    h, w = panes.shape
+    c = np.floor((cen[near] @ p.u - o.u0) / o.res).astype(int)
+    r = np.floor((o.v_top - cen[near, 2]) / o.res).astype(int)
+    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+    comp = lab[r[ok], c[ok]]
+    solid = np.bincount(comp, weights=(mesh.face_areas[near] * facing[near])[ok], minlength=n)
+    area = np.bincount(lab.ravel(), minlength=n) * o.res ** 2
+    drop = np.zeros(n, bool)
+    drop[1:] = solid[1:] >= max_share * area[1:]
+    return panes & ~drop[lab], drop[lab] & panes
+
+
 def _framed_holes(cov: np.ndarray, res: float, frame: float, cover: float, min_area: float,
                   min_side: float = 0.0, min_fill: float = 0.0) -> np.ndarray:
     """Holes in a plane's coverage ``cov`` framed all round by the plane's surface: each hole (8-connected,
@@ -578,7 +609,8 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         if not rays and cfg.image.coverage_tilt_deg > 0:
             cell_cov = coverage_from_faces(o, mesh, cfg.planes.min_fragment_area, cfg.image.coverage_close,
                                            cfg.image.coverage_tilt_depth, cfg.image.coverage_tilt_deg)
-        seen_at_plane = o.n_views > 0
+        views_at_plane = o.n_views.copy()
+        seen_at_plane = views_at_plane > 0
         o.n_views[~cov] = 0  # where the plane's surface is not (floor, worktop edge seen at the same depth)
         framing = pane_frame_map(cov, seen_at_plane if cfg.image.pane_seen else None, o.res, cfg.image.pane_speck,
                                  cfg.image.pane_gap, cfg.image.pane_seen_reach, cfg.image.pane_seen_max_cover,
@@ -586,6 +618,10 @@ def find_image_fronts(mesh: TriMesh, frames: Sequence[Frame], raster: Rasterizer
         panes = framed_panes(framing, o.res, cfg.image.pane_frame, cfg.image.pane_frame_cover, cfg.image.pane_min_area,
                              cfg.image.pane_rounds, cfg.image.pane_min_side, cfg.image.pane_bar,
                              cfg.image.pane_min_fill)
+        panes, solid = solid_panes(panes, o, mesh, cfg.image.pane_solid_depth, cfg.image.pane_solid_share)
+        if solid.any():  # a panel's middle is the front's surface, seen in its own colours
+            cov, cell_cov = cov | solid, cell_cov | solid
+            o.n_views[solid] = views_at_plane[solid]
         if panes.any():
             pane_regions.append(PaneRegion.of(o, panes, cfg.image.glass_behind_grow))
             cov = cov | panes
