@@ -57,11 +57,8 @@ def share_behind_panes(points: np.ndarray, region: PaneRegion, min_depth: float,
     o = region.ortho
     p = o.plane
     depth = p.d - points @ p.n  # > 0 behind the plane (the side away from the views)
-    rel = points - p.n * p.d
-    col = np.floor((rel @ p.u - o.u0) / o.res).astype(int)
-    row = np.floor((o.v_top - points[:, 2]) / o.res).astype(int)
-    h, w = region.mask.shape
-    inside = (col >= 0) & (col < w) & (row >= 0) & (row < h) & (depth >= min_depth) & (depth <= max_depth)
+    row, col, on_grid = o.pixels_of(points)
+    inside = on_grid & (depth >= min_depth) & (depth <= max_depth)
     hit = np.zeros(len(points), bool)
     hit[inside] = region.mask[row[inside], col[inside]]
     return float(hit.mean()) if len(points) else 0.0

@@ -133,15 +133,11 @@ def coverage_from_faces(o: Orthophoto, mesh: TriMesh, min_area: float, close: fl
     farther apart than ``close``, so their planes come out mostly uncovered. With ``tilt_deg`` > 0 the
     faces within ``slab`` m of the plane whose normals are tilted from its own by at most ``tilt_deg``
     paint it too (``slab_faces``)."""
-    h, w = o.n_views.shape
     faces = o.plane.faces
     if tilt_deg > 0:
         faces = np.union1d(faces, slab_faces(mesh, o.plane, slab, tilt_deg))
-    cen = mesh.face_centroids[faces]
-    c = np.floor((cen @ o.plane.u - o.u0) / o.res).astype(int)
-    r = np.floor((o.v_top - cen[:, 2]) / o.res).astype(int)
-    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
-    cov = np.zeros((h, w), np.uint8)
+    r, c, ok = o.pixels_of(mesh.face_centroids[faces])
+    cov = np.zeros(o.n_views.shape, np.uint8)
     cov[r[ok], c[ok]] = 1
     k = max(MIN_KERNEL, int(round(close / o.res)) | 1)
     cov = cv2.morphologyEx(cov, cv2.MORPH_CLOSE, np.ones((k, k), np.uint8))
@@ -311,16 +307,10 @@ def solid_panes(panes: np.ndarray, o: Orthophoto, mesh: TriMesh, depth: float, m
     if not panes.any() or max_share >= 1.0:
         return panes, np.zeros(panes.shape, bool)
     n, lab = cv2.connectedComponents(panes.astype(np.uint8), connectivity=CONNECTIVITY)
-    p = o.plane
-    cen, nrm = mesh.face_centroids, mesh.face_normals
-    facing = nrm @ p.n
-    near = np.flatnonzero((np.abs(cen @ p.n - p.d) <= depth) & (facing > 0))
-    h, w = panes.shape
-    c = np.floor((cen[near] @ p.u - o.u0) / o.res).astype(int)
-    r = np.floor((o.v_top - cen[near, 2]) / o.res).astype(int)
-    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
-    comp = lab[r[ok], c[ok]]
-    solid = np.bincount(comp, weights=(mesh.face_areas[near] * facing[near])[ok], minlength=n)
+    near = slab_faces(mesh, o.plane, depth, 90.0)  # facing out, however tilted
+    r, c, ok = o.pixels_of(mesh.face_centroids[near])
+    projected = mesh.face_areas[near] * (mesh.face_normals[near] @ o.plane.n)
+    solid = np.bincount(lab[r[ok], c[ok]], weights=projected[ok], minlength=n)
     area = np.bincount(lab.ravel(), minlength=n) * o.res ** 2
     drop = np.zeros(n, bool)
     drop[1:] = solid[1:] >= max_share * area[1:]
@@ -428,15 +418,12 @@ def protrusion_from_faces(o: Orthophoto, centroids: np.ndarray, normals: np.ndar
     around them instead: the median offset of the faces within ``win`` (``hc.surface_block`` blocks, each its
     faces' median), faces from ``behind`` the plane on. A TSDF wall lies a centimetre or two off its fitted
     plane in places, and its bumps there are no handles."""
-    h, w = o.n_views.shape
     p = o.plane
     depth = hc.protrusion_depth
     dn = centroids @ p.n - p.d
     # outward faces that can stand out: against the plane, from depth[0]; against the surface, from behind it
     cand = np.flatnonzero((dn > (-behind if win > 0 else depth[0])) & (dn < depth[1]) & (normals @ p.n > hc.protrusion_min_cos))
-    c = np.floor((centroids[cand] @ p.u - o.u0) / o.res).astype(int)
-    r = np.floor((o.v_top - centroids[cand, 2]) / o.res).astype(int)
-    ok = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+    r, c, ok = o.pixels_of(centroids[cand])
     return _protruding(dn[cand][ok], r[ok], c[ok], o, hc, win)
 
 

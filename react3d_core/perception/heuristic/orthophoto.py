@@ -59,6 +59,13 @@ class Orthophoto:
         return (self.u0 + (np.asarray(cols, float) + 0.5) * self.res,
                 self.v_top - (np.asarray(rows, float) + 0.5) * self.res)
 
+    def pixels_of(self, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Grid (rows, cols) of world ``points``' feet on the plane, and which of them fall on the grid."""
+        h, w = self.n_views.shape
+        cols = np.floor((points @ self.plane.u - self.u0) / self.res).astype(int)
+        rows = np.floor((self.v_top - points[:, 2]) / self.res).astype(int)
+        return rows, cols, (cols >= 0) & (cols < w) & (rows >= 0) & (rows < h)
+
     def grid_points(self) -> np.ndarray:
         """World points (H, W, 3) of every pixel centre, on the plane."""
         h, w = self.n_views.shape
