@@ -39,6 +39,7 @@ _MIN_SURFACE_DIV = 3  # the surface around a mesh handle: faces in at least a th
 _EDGE_NEAR = 0.01  # m: a cell this close to the coverage's top or bottom row runs along its edge
 _PORTHOLE_COVERED = 0.5  # a cell's front covering this share of a porthole door is the plate around it
 _PORTHOLE_SPAN = 0.9  # a strip spanning this share of a porthole door's width is the plate
+_ANY_OUTWARD_DEG = 90.0  # deg: a face tilted up to this from a plane's normal still faces out of it
 
 
 @dataclass
@@ -307,7 +308,7 @@ def solid_panes(panes: np.ndarray, o: Orthophoto, mesh: TriMesh, depth: float, m
     if not panes.any() or max_share >= 1.0:
         return panes, np.zeros(panes.shape, bool)
     n, lab = cv2.connectedComponents(panes.astype(np.uint8), connectivity=CONNECTIVITY)
-    near = slab_faces(mesh, o.plane, depth, 90.0)  # facing out, however tilted
+    near = slab_faces(mesh, o.plane, depth, _ANY_OUTWARD_DEG)
     r, c, ok = o.pixels_of(mesh.face_centroids[near])
     projected = mesh.face_areas[near] * (mesh.face_normals[near] @ o.plane.n)
     solid = np.bincount(lab[r[ok], c[ok]], weights=projected[ok], minlength=n)
