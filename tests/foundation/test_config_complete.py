@@ -426,6 +426,7 @@ DEFAULTS = {
     "perception.heuristic.seams.knob_pair_gap": 0.3,
     "perception.heuristic.seams.knob_pair_centre": 0.1,
     "perception.heuristic.seams.knob_seam": True,
+    "perception.heuristic.seams.clear_of_handles": True,
     "perception.heuristic.lines.enabled": False,
     "perception.heuristic.lines.weights": None,
     "perception.heuristic.lines.threads": 2,

@@ -78,6 +78,9 @@ class LearnedLines:
     blocked_r: np.ndarray
 
 
+_THROUGH_SHARE = 0.25  # a cut with at least this share of a handle on each side runs through it
+
+
 def _valleys(g: np.ndarray, axis: int, contrast: float, width_px: int) -> np.ndarray:
     """Pixels darker than both neighbours 1 to ``width_px`` px away along ``axis`` by ``contrast``."""
     out = np.zeros(g.shape, bool)
@@ -1074,42 +1077,79 @@ def _split_handles(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray
             and _door_pair_knobs(hs[0].box, hs[1].box, c.c0, c.c1, p))
     if max(span_x, span_y) < min_px and not pair:  # a door pair's knobs may sit closer than a front is wide
         return [c]
-    if span_x >= span_y:
-        gaps = np.diff(xs)
-        k = int(np.argmax(gaps))
-        if _nested(hs[k].box, hs[k + 1].box):
-            return [c]  # one lies across the other's columns (a bar over a frame rail): not side by side
-        lo, hi = int(hs[k].box[2]), int(hs[k + 1].box[0])
-        if hi - lo < 2:
-            lo, hi = int(xs[k]), int(xs[k + 1])
-        rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
-        knobs = p.knob_seam and hs[k].knob and hs[k + 1].knob
-        at = _between(g[0][rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
-                      None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
-                      (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0), seam_only=knobs)
-        if at is None and pair:
-            at = (hs[0].box[2] + hs[1].box[0]) // 2 - c.c0
-        if at is None:
-            return [c]  # two knobs side by side with no seam between them: one wide drawer's or a panel's
-        cut = c.c0 + at
-        a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
-        b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
-        if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1) or pc[cut - c.c0]:
-            return [c]  # handles overlapping across the cut (a bar seen twice): nothing to separate
-    else:
-        hs = sorted(c.handles, key=lambda h: h.center[1])
-        ys = [h.center[1] for h in hs]
-        k = int(np.argmax(np.diff(ys)))
-        lo, hi = int(hs[k].box[3]), int(hs[k + 1].box[1])
-        if hi - lo < 2:
-            lo, hi = int(ys[k]), int(ys[k + 1])
-        rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
-        cut = c.r0 + _between(g[1][rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p,
-                              None if learned is None else learned.horiz[rs, cs], 1.0 if learned is None else learned.span,
-                              (int(ys[k]) - c.r0, int(ys[k + 1]) - c.r0))
-        a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
-        b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
-        if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1) or pr[cut - c.r0]:
-            return [c]
+    args = (vert, horiz, cov, min_px, g, p, learned, pc, pr, pair)
+    first, second = (_cut_side_by_side, _cut_stacked) if span_x >= span_y else (_cut_stacked, _cut_side_by_side)
+    halves = first(c, *args)
+    if halves is not None and p.clear_of_handles and _through_handle(c, halves):
+        other = second(c, *args)
+        if other is not None and not _through_handle(c, other):
+            halves = other
+    if halves is None:
+        return [c]
+    a, b = halves
     return (_split_handles(a, vert, horiz, cov, min_px, g, p, learned, panes)
             + _split_handles(b, vert, horiz, cov, min_px, g, p, learned, panes))
+
+
+def _through_handle(c: Cell, halves: tuple[Cell, Cell]) -> bool:
+    """Whether the cut between ``halves`` runs through one of ``c``'s handles, leaving at least
+    ``_THROUGH_SHARE`` of it on each side (a bar is one front's: a cut across it is no seam; a handle's box,
+    grown by the bar closing and blurred by misregistration, reaches a few px over the seam beside it)."""
+    a, b = halves
+    side = a.c1 < b.c0  # side by side: the cut is the column between them
+    lo, hi = (a.c1, b.c0) if side else (a.r1, b.r0)
+    for h in c.handles:
+        h0, h1 = (h.box[0], h.box[2]) if side else (h.box[1], h.box[3])
+        if min(lo - h0, h1 - hi) >= _THROUGH_SHARE * (h1 - h0):
+            return True
+    return False
+
+
+def _cut_side_by_side(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int,
+                      g: tuple[np.ndarray, np.ndarray], p: SeamConfig, learned: LearnedLines | None,
+                      pc: np.ndarray, pr: np.ndarray, pair: bool) -> tuple[Cell, Cell] | None:
+    """``c`` cut at the best column in the widest gap between its handles' centres (None: no such cut)."""
+    hs = sorted(c.handles, key=lambda h: h.center[0])
+    xs = [h.center[0] for h in hs]
+    k = int(np.argmax(np.diff(xs)))
+    if _nested(hs[k].box, hs[k + 1].box):
+        return None  # one lies across the other's columns (a bar over a frame rail): not side by side
+    lo, hi = int(hs[k].box[2]), int(hs[k + 1].box[0])
+    if hi - lo < 2:
+        lo, hi = int(xs[k]), int(xs[k + 1])
+    rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
+    knobs = p.knob_seam and hs[k].knob and hs[k + 1].knob
+    at = _between(g[0][rs, cs], vert[rs, cs], cov[rs, cs], 0, lo - c.c0, hi - c.c0, min_px, p,
+                  None if learned is None else learned.vert[rs, cs], 1.0 if learned is None else learned.span,
+                  (int(xs[k]) - c.c0, int(xs[k + 1]) - c.c0), seam_only=knobs)
+    if at is None and pair:
+        at = (hs[0].box[2] + hs[1].box[0]) // 2 - c.c0
+    if at is None:
+        return None  # two knobs side by side with no seam between them: one wide drawer's or a panel's
+    cut = c.c0 + at
+    a = Cell(c.c0, c.r0, cut, c.r1, [h for h in c.handles if h.center[0] < cut], c.cut_sides + 1, c.seam_cuts)
+    b = Cell(cut + 1, c.r0, c.c1, c.r1, [h for h in c.handles if h.center[0] >= cut], c.cut_sides + 1, c.seam_cuts)
+    if not a.handles or not b.handles or not (c.c0 < cut < c.c1 - 1) or pc[cut - c.c0]:
+        return None  # handles overlapping across the cut (a bar seen twice): nothing to separate
+    return a, b
+
+
+def _cut_stacked(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndarray, min_px: int,
+                 g: tuple[np.ndarray, np.ndarray], p: SeamConfig, learned: LearnedLines | None,
+                 pc: np.ndarray, pr: np.ndarray, pair: bool) -> tuple[Cell, Cell] | None:
+    """``c`` cut at the best row in the widest gap between its handles' centres (None: no such cut)."""
+    hs = sorted(c.handles, key=lambda h: h.center[1])
+    ys = [h.center[1] for h in hs]
+    k = int(np.argmax(np.diff(ys)))
+    lo, hi = int(hs[k].box[3]), int(hs[k + 1].box[1])
+    if hi - lo < 2:
+        lo, hi = int(ys[k]), int(ys[k + 1])
+    rs, cs = slice(c.r0, c.r1), slice(c.c0, c.c1)
+    cut = c.r0 + _between(g[1][rs, cs], horiz[rs, cs], cov[rs, cs], 1, lo - c.r0, hi - c.r0, min_px, p,
+                          None if learned is None else learned.horiz[rs, cs], 1.0 if learned is None else learned.span,
+                          (int(ys[k]) - c.r0, int(ys[k + 1]) - c.r0))
+    a = Cell(c.c0, c.r0, c.c1, cut, [h for h in c.handles if h.center[1] < cut], c.cut_sides + 1, c.seam_cuts)
+    b = Cell(c.c0, cut + 1, c.c1, c.r1, [h for h in c.handles if h.center[1] >= cut], c.cut_sides + 1, c.seam_cuts)
+    if not a.handles or not b.handles or not (c.r0 < cut < c.r1 - 1) or pr[cut - c.r0]:
+        return None
+    return a, b

@@ -74,6 +74,33 @@ def test_cut_between_stacked_handles_finds_the_seam_inside_a_handle_box() -> Non
     assert (a.r1, b.r0) == (58, 59) and a.handles == [drawer] and b.handles == [door]
 
 
+def test_handles_are_cut_apart_clear_of_a_third_handle() -> None:
+    """A drawer (rows 0-59, its bar at columns 70-150, rows 25-31) over two doors (rows 61-199, meeting at
+    column 100, whose line runs on fainter up the drawer; handles at columns 20-25 and 175-180, rows 100-150).
+    The handles spread 155 px across and 97 px up, so the first cut is sought between columns, between the
+    left handle and the bar (centres 22 and 110, the widest gap): at the door seam, column 100, which has 30
+    of the bar's 80 px on its left and 50 on its right (both over a quarter): it would halve the drawer and
+    its bar. The cut between rows (the drawer's seam, row 60) runs through no handle, so it is taken first and
+    the doors are cut apart under it; with the rule off the drawer is halved."""
+    g = np.ones((200, 200))
+    g[60, :] = 0.85
+    g[61:, 100] = 0.85
+    g[:60, 100] = 0.92  # the door seam's line runs on, fainter, up the drawer (its shading)
+    cov = np.ones(g.shape, bool)
+    ev = np.zeros(g.shape, bool)
+    bar = Handle((70, 25, 150, 31), True, np.zeros((0, 2), int))
+    left = Handle((20, 100, 25, 150), False, np.zeros((0, 2), int))
+    right = Handle((175, 100, 180, 150), False, np.zeros((0, 2), int))
+    cell = Cell(0, 0, 200, 200, [bar, left, right])
+    cells = _split_handles(cell, ev, ev, cov, 25, (g, g), SeamConfig())
+    boxes = sorted((c.c0, c.r0, c.c1, c.r1) for c in cells)
+    assert boxes == [(0, 0, 200, 60), (0, 61, 100, 200), (101, 61, 200, 200)]
+    assert [c.handles for c in sorted(cells, key=lambda c: (c.c0, c.r0))] == [[bar], [left], [right]]
+    off = sorted((c.c0, c.r0, c.c1, c.r1) for c in _split_handles(cell, ev, ev, cov, 25, (g, g),
+                                                                   SeamConfig(clear_of_handles=False)))
+    assert off == [(0, 0, 100, 200), (101, 0, 200, 60), (101, 61, 200, 200)]
+
+
 def test_a_fronts_own_handle_is_no_clutter() -> None:
     """A 0.4 x 0.18 m drawer (4 mm px: 100 x 45 px, colour 1.0) alone in the orthophoto, its 0.3 x 0.03 m bar
     handle (75 x 7 = 525 px, 11.7 %, colour 1.6) off the background and 7 % of the other pixels off too (315
