@@ -413,6 +413,7 @@ class ClutterConfig(StageConfig):
 
     max_share: float = Field(0.18, ge=0, le=1, description="Share of a cell's pixels off its local background above which it is clutter (posters, tiles, shelves).")
     max_share_handle: float = Field(0.3, ge=0, le=1, description="The same share for a cell holding a handle (raised-panel doors shade their own faces; a handle is evidence of a front); never below max_share.")
+    handle_rim: float = Field(0.03, ge=0, description="In a cell holding a handle, the band this wide (m) along its edges is left out of the clutter share: a front's seams, a raised panel's bevel ring and a neighbour's colour bleeding over the seam lie there, and on small raised-panel doors (0.3 m) that band alone was a third of the cell (scene-synthesizer kitchens); a poster's or a shelf's clutter fills the middle. 0: the whole cell.")
     cell_median: bool = Field(True, description="A pixel is clutter only when it is also off the cell's own median colour (a band along an edge shared with a front of another colour is not).")
     median_min_px: int = Field(50, ge=0, description="... judged so only on cells with at least this many seen pixels outside the line structure.")
     line_min_len: float = Field(0.15, ge=0, description="Straight horizontal/vertical lines at least this long (m) are a front's structure (shaker frames, tile joints), not clutter; 0 counts them.")

@@ -521,6 +521,7 @@ DEFAULTS = {
     "perception.heuristic.portholes.bar_cuts": True,
     "perception.heuristic.clutter.max_share": 0.18,
     "perception.heuristic.clutter.max_share_handle": 0.3,
+    "perception.heuristic.clutter.handle_rim": 0.03,
     "perception.heuristic.clutter.cell_median": True,
     "perception.heuristic.clutter.median_min_px": 50,
     "perception.heuristic.clutter.line_min_len": 0.15,

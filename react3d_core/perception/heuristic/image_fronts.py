@@ -939,6 +939,23 @@ def _clutter_share(o: Orthophoto, cell: Cell, clutter: np.ndarray, seen: np.ndar
     return min(share, float(off[keep].mean()))
 
 
+def _inner(shape: tuple[int, ...], rim: int) -> np.ndarray:
+    """A cell's pixels farther than ``rim`` px from its edges (all of them where the cell is too small)."""
+    m = np.zeros(shape[:2], bool)
+    if 2 * rim >= min(shape[:2]):
+        m[:] = True
+    else:
+        m[rim:shape[0] - rim, rim:shape[1] - rim] = True
+    return m
+
+
+def _inside_rim(cell: Cell, h: Handle, rim: int) -> bool:
+    """Whether handle ``h``'s centre lies farther than ``rim`` px inside ``cell``'s edges (a front's grip
+    sits on its face, not on the seam or the floor line along its edge)."""
+    x, y = h.center
+    return cell.c0 + rim <= x < cell.c1 - rim and cell.r0 + rim <= y < cell.r1 - rim
+
+
 def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray, in_plane: np.ndarray,
                 cfg: HeuristicConfig, taken: np.ndarray | None,
                 plain: tuple[float, np.ndarray] | None = None, one_cut: bool = False) -> Front | None:
@@ -950,6 +967,10 @@ def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray,
         return None
     seen = o.n_views[cell.r0:cell.r1, cell.c0:cell.c1] > 0
     limit = max(clut.max_share, clut.max_share_handle) if cell.handles else clut.max_share
+    rim = int(round(clut.handle_rim / o.res))
+    if cell.handles and cell.cut_sides >= _MIN_CUT_SIDES and all(_inside_rim(cell, h, rim) for h in cell.handles):
+        # a front cut out by seams: its own rim (the seams, a raised panel's bevel ring, a neighbour's colour) is no clutter
+        seen = seen & _inner(seen.shape, rim)
     if seen.any() and _clutter_share(o, cell, clutter, seen, plain, clut.median_min_px) > limit:
         return None  # posters, tiles, shelves: a front is a plain panel
     rows, cols = np.nonzero(sub)

@@ -703,6 +703,38 @@ def test_a_cell_with_a_handle_may_be_more_cluttered() -> None:
     assert _cell_front(o, with_handle, cov, clutter, in_plane, cfg, None) is None
 
 
+def test_a_cut_out_fronts_rim_is_no_clutter() -> None:
+    """A 0.32 x 0.24 m raised-panel door (5 mm px: 64 x 48 px) cut out on four sides, its 3 cm rim (6 px: the
+    seams and the bevel ring) off the background all round: 3072 - 52 x 36 = 1200 px, 39 % of the cell, over
+    clutter.max_share_handle 0.3, so it was clutter; its middle is plain (0 %), so with the rim left out it is a
+    front. Not so with the rim rule off, with the cell cut on one side only (its other edges the plane's
+    outline: a plinth over the floor line) or with its handle's centre on the rim."""
+    from react3d_core.perception.heuristic.front_cells import Cell, Handle
+    from react3d_core.perception.heuristic.image_fronts import _cell_front
+
+    h, w, res = 48, 64, 0.005
+    o = _ortho(np.ones((h, w, 3), np.float32), res)
+    cov = np.ones((h, w), bool)
+    clutter = np.ones((h, w), bool)
+    clutter[6:-6, 6:-6] = False
+    assert clutter.sum() == 1200
+    uu, zz = np.meshgrid(np.arange(0.005, 0.32, 0.01), np.arange(0.005, 0.24, 0.01))
+    in_plane = np.stack([uu.ravel(), zz.ravel(), np.zeros(uu.size)], 1)
+
+    def handle(c: int, r: int) -> Handle:
+        pix = np.stack(np.meshgrid(np.arange(c, c + 3), np.arange(r, r + 16)), -1).reshape(-1, 2)
+        return Handle((c, r, c + 3, r + 16), False, pix)
+
+    cfg = HeuristicConfig()
+    assert round(cfg.clutter.handle_rim / res) == 6
+    door = Cell(0, 0, w, h, handles=[handle(50, 16)], cut_sides=4)
+    f = _cell_front(o, door, cov, clutter, in_plane, cfg, None)
+    assert f is not None and abs(f.w - 0.32) < 0.01 and abs(f.h - 0.24) < 0.01
+    assert _cell_front(o, door, cov, clutter, in_plane, HeuristicConfig(clutter={"handle_rim": 0.0}), None) is None
+    assert _cell_front(o, Cell(0, 0, w, h, handles=[handle(50, 16)], cut_sides=1), cov, clutter, in_plane, cfg, None) is None
+    assert _cell_front(o, Cell(0, 0, w, h, handles=[handle(60, 16)], cut_sides=4), cov, clutter, in_plane, cfg, None) is None
+
+
 def _quad(x0: float, x1: float, y0: float, y1: float, z: float) -> TriMesh:
     v = np.array([[x0, y0, z], [x1, y0, z], [x1, y1, z], [x0, y1, z]], float)
     return TriMesh(v, np.array([[0, 1, 2], [0, 2, 3]]))
