@@ -495,6 +495,7 @@ DEFAULTS = {
     "perception.heuristic.cells.sliver_max": 0.13,
     "perception.heuristic.cells.sliver_ratio": 1.5,
     "perception.heuristic.cells.min_seen": 0.55,
+    "perception.heuristic.cells.seen_rim": True,
     "perception.heuristic.cells.min_tile_side": 0.25,
     "perception.heuristic.cells.min_tiles": 3,
     "perception.heuristic.cells.tile_edge_strips": False,

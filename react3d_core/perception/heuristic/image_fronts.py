@@ -963,14 +963,19 @@ def _cell_front(o: Orthophoto, cell: Cell, cov: np.ndarray, clutter: np.ndarray,
     on two sides, or with ``one_cut`` on one (kept later only by ``plain_fronts_kept``'s rules)."""
     rules, clut = cfg.fronts, cfg.clutter
     sub = cov[cell.r0:cell.r1, cell.c0:cell.c1]
-    if sub.size == 0 or sub.mean() < cfg.cells.min_seen:
+    if sub.size == 0:
+        return None
+    rim = int(round(clut.handle_rim / o.res))
+    # a front cut out by seams, its grip on its face: its own rim holds the seams, a raised panel's bevel ring
+    # and a neighbour's colour, and on a fused scan the grooves and bevels the surface leaves
+    inner = (_inner(sub.shape, rim) if cell.handles and cell.cut_sides >= _MIN_CUT_SIDES
+             and all(_inside_rim(cell, h, rim) for h in cell.handles) else None)
+    if (sub[inner] if inner is not None and cfg.cells.seen_rim else sub).mean() < cfg.cells.min_seen:
         return None
     seen = o.n_views[cell.r0:cell.r1, cell.c0:cell.c1] > 0
     limit = max(clut.max_share, clut.max_share_handle) if cell.handles else clut.max_share
-    rim = int(round(clut.handle_rim / o.res))
-    if cell.handles and cell.cut_sides >= _MIN_CUT_SIDES and all(_inside_rim(cell, h, rim) for h in cell.handles):
-        # a front cut out by seams: its own rim (the seams, a raised panel's bevel ring, a neighbour's colour) is no clutter
-        seen = seen & _inner(seen.shape, rim)
+    if inner is not None:
+        seen = seen & inner
     if seen.any() and _clutter_share(o, cell, clutter, seen, plain, clut.median_min_px) > limit:
         return None  # posters, tiles, shelves: a front is a plain panel
     rows, cols = np.nonzero(sub)
