@@ -119,6 +119,7 @@ class SplashbackConfig(StageConfig):
     reach: tuple[float, float] = Field((0.03, 0.33), description="The strip in front of the front examined for a worktop (m in front, from/to).")
     cover: float = Field(0.2, ge=0, le=1, description="Share of that strip the worktop must cover.")
     min_up: float = Field(0.7, ge=0, le=1, description="Worktop faces: the normal's z is above this (a scanned worktop is noisy and cluttered: its faces tilt).")
+    run_depth: tuple[float, float] = Field((0.45, 0.8), description="A front also stands on a worktop when another front, this far in front of it (m, from/to: a worktop's depth; a microwave's door is nearer the run's front line), overlaps it across with its top edge within band of the front's bottom: the run under a worktop the mesh lacks (black granite returns no depth). (0, 0): off.")
 
 
 class RoomWallConfig(StageConfig):
@@ -332,7 +333,8 @@ class HandleConfig(StageConfig):
     """Handles in the orthophotos and in the mesh (perception/heuristic/front_cells.py, image_fronts.py)."""
 
     contrast: float = Field(0.12, ge=0, description="Colour distance of handle pixels from the local background.")
-    length: tuple[float, float] = Field((0.1, 0.5), description="Long side of a handle (m).")
+    length: tuple[float, float] = Field((0.1, 0.6), description="Long side of a handle (m): a wide door's bar is up to ~0.5 m and its blob, blurred by the views' misregistration and joined to the shadow beside it, longer (RedKitchen's corner door: its 0.49 m bar, joined to the worktop's shadow band, made a 0.5-0.6 m blob and the door had no handle).")
+    strip_length: float = Field(0.5, gt=0, description="Colour runs at least this long along a row or a column are strips (shadow lines along an edge, seams, a plinth's line) and are removed with the pixels beside them before handles are sought; shorter than the longest handle (length): a plinth's 0.5-0.6 m shadow line kept as a handle stopped a dark drawer column's cuts (dark tuning 350).")
     thickness: tuple[float, float] = Field((0.014, 0.07), description="Short side of a handle (m).")
     aspect: float = Field(2.2, ge=1, description="Long side at least this times the short side.")
     min_fill: float = Field(0.4, ge=0, le=1, description="A handle blob fills at least this share of its box.")
@@ -346,6 +348,7 @@ class HandleConfig(StageConfig):
     side_cover: float = Field(0.4, ge=0, le=1, description="The plane's outline covers at least this share of the side_band on each long side of a handle (out of the grid counts as uncovered): a handle sits on a front, a ridge at the plane's end (a wall corner, a unit's side) has the plane on one side only (RedKitchen: a door made from a ridge at the tiled wall's end). 0: off.")
     hidden_side: float = Field(0.5, ge=0, le=1, description="A colour-only handle (under bar_share of it standing out of the scan) with at least this share of the side_band along one long side on the plane's surface but seen by no view, and as much of the band hidden_depth out on that side, is the edge of something hiding the plane (a chair, a box, the next piece) or the plane's own lit edge, not a handle: the sides and backs of pieces standing free became doors there (free-standing tuning laser scans, 4 false fronts), and a RedKitchen door was cut in two at the edge of what a chair hides. A handle's scanning shadow is no surface of the scan. 0: off.")
     hidden_depth: float = Field(0.06, ge=0, description="... the hidden surface reaches this far (m) from the handle: a real handle, or a worktop's overhang above a top handle, hides a strip of up to about 5 cm from oblique views (RedKitchen's left run: with the first band alone, 7 of 9 fronts -> 4 at every 5th frame); an occluder hides more. 0: the first band only.")
+    few_views: float = Field(0.2, ge=0, le=1, description="A colour-only handle (under bar_share of it standing out of the scan) whose pixels are seen by a median number of views under this share of the median over the plane's seen pixels is no handle: it lies on the shore of what the views see (a base unit's bottom edge seen past an island by one or two grazing views), where colour is one view's, misregistered; the bars a handle is taken from are seen by about as many views as the front around them. 0: off.")
     protrusion_depth: tuple[float, float] = Field((0.012, 0.09), description="Mesh faces this far in front of the plane mark handles (m).")
     protrusion_min_cos: float = Field(0.5, ge=-1, le=1, description="... facing outwards: the cosine between a face's normal and the plane's above this.")
     protrusion_from_surface: bool = Field(True, description="Mesh handles stand protrusion_depth in front of the surface around them (median offset of the faces within background_win) instead of in front of the fitted plane, so a TSDF wall's bumps off its plane are no handles (heuristic version 14, with side_cover). Tuning scenes, front F1: TSDF 0.801 -> 0.812, laser 0.826 -> 0.834 (docs/perception.md).")

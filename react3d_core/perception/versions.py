@@ -98,8 +98,11 @@ name them without importing the backends (Open3D, OpenCV)."""
 # 50: handles are cut apart clear of a third handle (seams.clear_of_handles: a drawer's bar over the seams of the
 #     doors below); a cut-out front's rim (clutter.handle_rim) is left out of its clutter and coverage shares
 #     (cells.seen_rim)
+# 51: colour seen by few views is no handle (handles.few_views); bars up to 0.6 m (handles.length); a bar painted at
+#     two heights is not cut apart; fronts level with the top of a run standing a worktop's depth in front of them
+#     are splash-back (splashback.run_depth)
 # (opt-in, off it changes nothing: the faces no offset peak took vote again, planes.residual_dip: a front set back
 # a few cm beside a larger one, a microwave on its cabinet)
-HEURISTIC_VERSION = "50"
+HEURISTIC_VERSION = "51"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -41,15 +41,14 @@ def scene():
 def test_redkitchen_fronts_found_as_separate_parts(tmp_path, scene, prefect_server):
     """>= 7 of 9 fronts, each its own part covering one front, plausible joints, <= 1 false part.
 
-    On the 50 frames of ``--stride 5``, the view set the heuristic was tuned and documented on. The
-    heuristic's RedKitchen result depends on the view set: 7-Scenes' colour frames are each misregistered
-    by their own amount, so the fused orthophotos differ (full pipeline: the default keyframe selection
-    keeps 119 frames and finds 5 / 3, against 7 / 1 for stride 5; docs/results.md)."""
+    With the default frames (the keyframe selection keeps 119 of 250), what a user gets. The heuristic's
+    RedKitchen result depends on the view set: 7-Scenes' colour frames are each misregistered by their own
+    amount, so the fused orthophotos differ (every 3rd, 4th and 5th frame: docs/results.md)."""
     out = tmp_path / "out"
     env = dict(os.environ, REACT3D_CACHE=str(tmp_path / "cache"),  # a cold cache: the run is the pipeline's
                PREFECT_HOME=str(prefect_server.home))  # the run's Prefect server, not one in the user's home
     env.pop("PREFECT_API_URL", None)
-    proc = subprocess.run([sys.executable, "-m", "flows.cli", "convert", str(SCENE), "--out", str(out), "--stride", "5"],
+    proc = subprocess.run([sys.executable, "-m", "flows.cli", "convert", str(SCENE), "--out", str(out)],
                           cwd=REPO, env=env, capture_output=True, text=True, timeout=1800)
     assert proc.returncode == 0, proc.stdout[-2000:] + proc.stderr[-2000:]
     report = evaluate_box_labels(out, scene, LABELS)

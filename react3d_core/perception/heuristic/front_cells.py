@@ -32,6 +32,7 @@ _ACROSS_ROW = np.ones((1, 3), np.uint8)  # a pixel and its left/right neighbours
 _ACROSS_COL = np.ones((3, 1), np.uint8)  # ... and its upper/lower ones
 _MIN_LINES = 3  # a profile of fewer usable lines has no seam
 _EDGE_BAND_DIV = 3  # a cut may run through at most a third of a bar's box at each edge (its middle stays blocked)
+_TWICE_PX = 2  # two bars' boxes may share this many columns at their ends (a box is blurred a px or two)
 _PAIR_BAND_DIV = 3  # a cut may run through the middle third of a bar pair's box (its outer thirds stay blocked)
 
 
@@ -212,8 +213,8 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     # a handle that is in the mesh: its footprint in front of the plane
     bar = np.zeros_like(colour) if protrusion is None else protrusion.astype(np.uint8)
     blob = colour | bar
-    # strips longer than any handle (shadow lines along an edge, seams) would join handles: remove them
-    L = int(p.length[1] / o.res) + 1
+    # strips (shadow lines along an edge, seams) would join handles: remove them
+    L = int(p.strip_length / o.res) + 1
     strips = cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((1, L), np.uint8)) | \
         cv2.morphologyEx(blob, cv2.MORPH_OPEN, np.ones((L, 1), np.uint8))
     keep = 1 - cv2.dilate(strips, NEIGHBOURS)
@@ -226,6 +227,7 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     mesh_bars = bar & keep if p.mesh_bar_parts else None
     out = []
     seams = hidden = None
+    plane_views = float(np.median(o.n_views[valid]))
     for j, x, y, w, h, area, bar, knob in _candidates(lab, stats, n, mesh_bars, o.res, p, bars_only):
         if not (bar or knob):
             continue
@@ -247,6 +249,8 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
             if _at_hidden_edge(hidden, protrusion, lab[y:y + h, x:x + w] == j, (x, y, w, h), pad, p, depth):
                 continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
+        if p.few_views > 0 and not bars_only and _few_views(o.n_views, rows + y, cols + x, protrusion, p, plane_views):
+            continue
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
     if p.knob_pair > 0:
         kept = knobs_in_patterns(out, p.knob_pair / o.res, p.knob_pair_size, p.knob_pair_reach / o.res,
@@ -321,6 +325,19 @@ def _at_hidden_edge(hidden: np.ndarray, protrusion: np.ndarray | None, mine: np.
     g = depth_px - pad
     far = _side_cover(hidden, box, pad, g) if g > 0 else near
     return any(a >= p.hidden_side and b >= p.hidden_side for a, b in zip(near, far))
+
+
+def _few_views(n_views: np.ndarray, rows: np.ndarray, cols: np.ndarray, protrusion: np.ndarray | None,
+               p: HandleConfig, plane_views: float) -> bool:
+    """Whether a blob (its pixels at ``rows``, ``cols``) is colour only (under ``p.bar_share`` of it on
+    ``protrusion``) and seen by a median number of views under ``p.few_views`` times ``plane_views`` (the
+    median over the plane's seen pixels). Why: such a blob lies on the shore of what the views see, where
+    the colour is that of one or two grazing views, misregistered (RedKitchen at 100k faces: the bottom
+    edge of a base unit seen past the island by a median of 2 views, against 17-27 on its handles, became
+    a handle and cut two doors apart along their handles); a ratio, so it holds at any number of frames."""
+    if protrusion is not None and float(protrusion[rows, cols].mean()) >= p.bar_share:
+        return False
+    return float(np.median(n_views[rows, cols])) < p.few_views * plane_views
 
 
 def stand_out(handles: Sequence[Handle], bars: np.ndarray, share: float) -> list[bool]:
@@ -1002,6 +1019,17 @@ def _between(g: np.ndarray, ev: np.ndarray, cov: np.ndarray, axis: int, lo: int,
     return None if seam_only else (lo + hi) // 2
 
 
+def _bar_seen_twice(a: Handle, b: Handle) -> bool:
+    """Whether two horizontal bars share more than ``_TWICE_PX`` columns: no vertical seam runs between
+    them, so they are one bar painted at two heights (views looking down at different angles paint a proud
+    bar lower on the front the steeper they look; RedKitchen's corner door got two such pieces, 2.4 cm
+    apart, and was cut in two between them). Two doors' bars side by side leave a gap: bars nearer than
+    ``handles.join_gap`` along a row are joined into one blob before this."""
+    if not (a.horizontal and b.horizontal) or a.knob or b.knob:
+        return False
+    return min(a.box[2], b.box[2]) - max(a.box[0], b.box[0]) > _TWICE_PX
+
+
 def _nested(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> bool:
     """Whether the columns of one pixel box lie within those of the other."""
     return (a[0] <= b[0] and b[2] <= a[2]) or (b[0] <= a[0] and a[2] <= b[2])
@@ -1114,6 +1142,8 @@ def _cut_side_by_side(c: Cell, vert: np.ndarray, horiz: np.ndarray, cov: np.ndar
     k = int(np.argmax(np.diff(xs)))
     if _nested(hs[k].box, hs[k + 1].box):
         return None  # one lies across the other's columns (a bar over a frame rail): not side by side
+    if _bar_seen_twice(hs[k], hs[k + 1]):
+        return None
     lo, hi = int(hs[k].box[2]), int(hs[k + 1].box[0])
     if hi - lo < 2:
         lo, hi = int(xs[k]), int(xs[k + 1])

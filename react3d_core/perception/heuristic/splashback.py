@@ -7,6 +7,11 @@ A wall cabinet hangs well above the worktop; an appliance standing on the workto
 in front of the wall, with the worktop ending at its door. So a front is dropped when a horizontal,
 upward-facing surface runs level with its bottom edge (within ``band``), above ``min_z``, and covers at
 least ``cover`` of a strip ``reach`` deep in front of it (``perception.heuristic.splashback``).
+
+A black or glossy worktop returns no depth and is not in the mesh (RedKitchen's black granite). The run
+under it still is: a front whose bottom edge is level with the top of another front standing ``run_depth``
+in front of it (a worktop's depth; a microwave's door is nearer the run's front line) and overlapping it
+across, stands at the back of that run's worktop too.
 """
 
 from __future__ import annotations
@@ -16,6 +21,8 @@ import numpy as np
 from ...config.heuristic import SplashbackConfig
 from ...data.mesh import TriMesh
 from .fronts import Front
+
+_PARALLEL_COS = 0.95  # fronts of one run and the wall behind it face the same way (within ~18 degrees)
 
 
 def on_worktop(fronts: list[Front], mesh: TriMesh, rules: SplashbackConfig) -> list[bool]:
@@ -37,5 +44,24 @@ def on_worktop(fronts: list[Front], mesh: TriMesh, rules: SplashbackConfig) -> l
         sel = ((d > rules.reach[0]) & (d < rules.reach[1]) & (cu > f.extent_u[0]) & (cu < f.extent_u[1])
                & (np.abs(cen[:, 2] - bottom) < rules.band))
         strip = max(f.w * (rules.reach[1] - rules.reach[0]), 1e-9)
-        out.append(bool(area[sel].sum() >= rules.cover * strip))
+        out.append(bool(area[sel].sum() >= rules.cover * strip) or _behind_run(f, fronts, rules))
     return out
+
+
+def _behind_run(f: Front, fronts: list[Front], rules: SplashbackConfig) -> bool:
+    """Whether another front of ``fronts``, parallel to ``f``, stands ``rules.run_depth`` in front of it, overlaps
+    it across and has its top edge within ``rules.band`` of ``f``'s bottom edge: the run whose worktop ``f``
+    stands on (see module docstring; ``run_depth`` (0, 0): off)."""
+    lo, hi = rules.run_depth
+    if hi <= 0:
+        return False
+    bottom = float(f.extent_v[0])
+    for g in fronts:
+        if g is f or float(g.n_out @ f.n_out) < _PARALLEL_COS:
+            continue
+        ahead = float((g.center - f.center) @ f.n_out)
+        gu = float(g.center @ f.u)
+        across = min(gu + g.w / 2, f.extent_u[1]) - max(gu - g.w / 2, f.extent_u[0])
+        if lo <= ahead <= hi and across > 0 and abs(float(g.extent_v[1]) - bottom) < rules.band:
+            return True
+    return False

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from react3d_core.config.heuristic import HeuristicConfig, SeamConfig
-from react3d_core.perception.heuristic.front_cells import (Cell, Handle, _between, _dip_scores, _split_handles,
-                                                           find_handles, split_cells)
+from react3d_core.perception.heuristic.front_cells import (Cell, Handle, _bar_seen_twice, _between, _dip_scores,
+                                                           _split_handles, find_handles, split_cells)
 from react3d_core.perception.heuristic.fronts import Front
 from react3d_core.perception.heuristic.image_fronts import VetoEvidence, _cluttered, _hardware
 from tests.perception.heuristic.flat_orthos import flat_ortho
@@ -99,6 +99,28 @@ def test_handles_are_cut_apart_clear_of_a_third_handle() -> None:
     off = sorted((c.c0, c.r0, c.c1, c.r1) for c in _split_handles(cell, ev, ev, cov, 25, (g, g),
                                                                    SeamConfig(clear_of_handles=False)))
     assert off == [(0, 0, 100, 200), (101, 0, 200, 60), (101, 61, 200, 200)]
+
+
+def test_a_bar_painted_at_two_heights_is_not_cut_apart() -> None:
+    """One door (130 x 185 px, a little noise, no seam) whose bar the views painted at two heights: columns
+    29-59 at rows 21-25 and columns 53-97 at rows 32-36 (RedKitchen's corner door). Their centres lie 31 px
+    apart across and 11 px up, more than min_px (25) across, so the cell was cut side by side between them.
+    They share columns 53-59 (7 > 2), so no vertical seam runs between them: one front. Bars sharing 2
+    columns (29-54 and 53-97), or one bar above a knob, are still cut apart."""
+    rng = np.random.default_rng(4)
+    g = np.ones((185, 130)) + rng.normal(0, 0.003, (185, 130))
+    cov = np.ones(g.shape, bool)
+    ev = np.zeros(g.shape, bool)
+    p = SeamConfig()
+    upper = Handle((29, 21, 60, 26), True, np.zeros((0, 2), int))
+    lower = Handle((53, 32, 98, 37), True, np.zeros((0, 2), int))
+    assert _bar_seen_twice(upper, lower) and _bar_seen_twice(lower, upper)
+    assert len(_split_handles(Cell(0, 0, 130, 185, [upper, lower]), ev, ev, cov, 25, (g, g), p)) == 1
+    short = Handle((29, 21, 55, 26), True, np.zeros((0, 2), int))
+    assert not _bar_seen_twice(short, lower)
+    assert len(_split_handles(Cell(0, 0, 130, 185, [short, lower]), ev, ev, cov, 25, (g, g), p)) == 2
+    knob = Handle((53, 32, 60, 39), True, np.zeros((0, 2), int), True)
+    assert not _bar_seen_twice(upper, knob)
 
 
 def test_a_fronts_own_handle_is_no_clutter() -> None:

@@ -69,3 +69,25 @@ def test_a_narrow_hidden_strip_is_what_a_handle_hides() -> None:
         o.n_views[76:r1, :] = 0
         got = find_handles(o, cov, HeuristicConfig(handles={"hidden_depth": depth}))
         assert (len(got) == 1) == kept, (r1, depth)
+
+
+def test_colour_seen_by_few_views_is_no_handle() -> None:
+    """The panel is seen by 10 views everywhere (its median), the blob by 1 view: 1 < 0.2 x 10 = 2, so it
+    goes (the shore of what the views see: one grazing view's colour); seen by 2 views, 2 < 2 is false and it
+    stays. With the rule off (0) it stays; standing out of the scan (the protrusion map) it stays too."""
+    cov = np.ones((_H, _W), bool)
+    on, off = HeuristicConfig(), HeuristicConfig(handles={"few_views": 0.0})
+    assert on.handles.few_views == 0.2
+
+    def ortho(views: int):  # noqa: ANN202 - a test helper
+        o = flat_ortho(_panel())
+        o.n_views[:] = 10
+        o.n_views[_BAR] = views
+        return o
+
+    assert find_handles(ortho(1), cov, on) == []
+    assert len(find_handles(ortho(2), cov, on)) == 1
+    assert len(find_handles(ortho(1), cov, off)) == 1
+    bars = np.zeros((_H, _W), bool)
+    bars[_BAR] = True
+    assert len(find_handles(ortho(1), cov, on, protrusion=bars)) == 1

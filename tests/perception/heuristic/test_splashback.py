@@ -67,3 +67,21 @@ def test_rules_from_config_and_switch() -> None:
     assert h.splashback.enabled and (h.splashback.min_z, h.splashback.cover) == (0.5, 0.2)
     off = PipelineConfig().with_overrides({"perception": {"heuristic": {"splashback": {"enabled": False}}}}).perception.heuristic
     assert off.splashback.enabled is False
+
+
+def test_run_below_stands_for_a_worktop_the_mesh_lacks() -> None:
+    """A black worktop returned no depth: the mesh holds the wall (y = 0.6) and the floor only. In front of the
+    wall stands a base run whose door (y = 0.0, x 0.2-0.8, 0.1-0.88 m) is 0.6 m ahead of the wall (inside
+    ``run_depth`` 0.45-0.8):
+    - a panel on the wall from 0.92 m (0.04 above the door's top, within ``band`` 0.08), x 0.5-1.1, overlapping
+      the door across by 0.3 m: splash-back (dropped); with ``run_depth`` (0, 0) it is kept;
+    - the same panel at x 1.0-1.6, past the door's end: kept;
+    - a wall cabinet from 1.45 m: 0.57 above the door's top, kept;
+    - a microwave's door standing on the worktop 0.2 m behind the door (y = 0.2, 0.92-1.2 m): kept."""
+    mesh = _mesh(_quad(-1.0, 4.0, -2.0, 0.6, 0.0, 0.0), _quad(0.0, 4.0, 0.6, 0.6, 0.0, 2.4))
+    door = _front(0.2, 0.8, 0.1, 0.88, y=0.0)
+    fronts = [door, _front(0.5, 1.1, 0.92, 1.40), _front(1.0, 1.6, 0.92, 1.40), _front(0.2, 0.8, 1.45, 2.15),
+              _front(0.3, 0.7, 0.92, 1.2, y=0.2)]
+    assert SplashbackConfig().run_depth == (0.45, 0.8)
+    assert on_worktop(fronts, mesh, SplashbackConfig()) == [False, True, False, False, False]
+    assert on_worktop(fronts, mesh, SplashbackConfig(run_depth=(0.0, 0.0))) == [False] * 5
