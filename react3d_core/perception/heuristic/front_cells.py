@@ -227,7 +227,8 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
     mesh_bars = bar & keep if p.mesh_bar_parts else None
     out = []
     seams = hidden = None
-    plane_views = float(np.median(o.n_views[valid]))
+    # the plane's median view count, read only by few_views (and None with min_seen_px 0 on an unseen plane)
+    plane_views = float(np.median(o.n_views[valid])) if p.few_views > 0 and valid.any() else None
     for j, x, y, w, h, area, bar, knob in _candidates(lab, stats, n, mesh_bars, o.res, p, bars_only):
         if not (bar or knob):
             continue
@@ -249,7 +250,7 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
             if _at_hidden_edge(hidden, protrusion, lab[y:y + h, x:x + w] == j, (x, y, w, h), pad, p, depth):
                 continue
         rows, cols = np.nonzero(lab[y:y + h, x:x + w] == j)
-        if p.few_views > 0 and not bars_only and _few_views(o.n_views, rows + y, cols + x, protrusion, p, plane_views):
+        if plane_views is not None and not bars_only and _few_views(o.n_views, rows + y, cols + x, protrusion, p, plane_views):
             continue
         out.append(Handle((int(x), int(y), int(x + w), int(y + h)), bool(w >= h), np.stack([cols + x, rows + y], 1), knob))
     if p.knob_pair > 0:
