@@ -13,6 +13,17 @@ from scipy.spatial.transform import Rotation
 from .collision import ConvexPiece
 
 
+def rpy_of(R: np.ndarray) -> np.ndarray:
+    """URDF rpy (extrinsic XYZ roll, pitch, yaw) of rotation matrix ``R``.
+
+    Axis-aligned frames (principal axes of symmetric parts, boxes standing on end) often have a pitch of
+    +-90 degrees (gimbal lock): SciPy then sets the yaw to 0 and the roll takes the rest, which still gives
+    ``R`` exactly, so its warning about it is silenced."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        return Rotation.from_matrix(R).as_euler("xyz")
+
+
 @dataclass
 class Inertial:
     """Mass (kg), centre of mass (world, m), principal moments (kg m^2) and axes (columns, det +1)."""
@@ -27,13 +38,8 @@ class Inertial:
         return self.axes @ np.diag(self.moments) @ self.axes.T
 
     def rpy(self) -> np.ndarray:
-        """URDF rpy (extrinsic XYZ) of the principal frame.
-
-        Principal axes of symmetric parts are often axis-aligned (gimbal lock): any valid rpy of the same
-        rotation is fine for URDF, so SciPy's warning about it is silenced."""
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", UserWarning)
-            return Rotation.from_matrix(self.axes).as_euler("xyz")
+        """URDF rpy (extrinsic XYZ) of the principal frame."""
+        return rpy_of(self.axes)
 
     def quat_wxyz(self) -> np.ndarray:
         x, y, z, w = Rotation.from_matrix(self.axes).as_quat()
@@ -79,8 +85,9 @@ def inertial_from_pieces(pieces: list[ConvexPiece], density: float, min_mass: fl
     for p in pieces:
         tm = trimesh.Trimesh(p.vertices, p.faces, process=False)
         tm.density = density
-        props = tm.mass_properties
-        vol = abs(float(props["volume"]))
+        with np.errstate(invalid="ignore", divide="ignore"):  # a flat piece: no volume, skipped below
+            props = tm.mass_properties
+            vol = abs(float(props["volume"]))
         if vol <= 0:
             continue
         ms.append(vol * density)

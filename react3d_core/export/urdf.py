@@ -23,12 +23,12 @@ from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ..atomic import write_text
 from ..config.export import ExportConfig
 from .assets import LinkFiles
 from .collision import ConvexPiece
+from .inertia import rpy_of
 from .model import Link, SceneModel
 
 
@@ -57,7 +57,7 @@ def _inertial(link: Link) -> list[str]:
 def _box(piece: ConvexPiece, frame: np.ndarray) -> tuple[str, str, str]:
     """(xyz, rpy, geometry) of a box piece: URDF's rpy is fixed-axis roll, pitch, yaw (R = Rz Ry Rx)."""
     c, R, ext = piece.box_frame()
-    return _v(c - frame), _v(Rotation.from_matrix(R).as_euler("xyz")), f'<box size="{_v(ext)}"/>'
+    return _v(c - frame), _v(rpy_of(R)), f'<box size="{_v(ext)}"/>'
 
 
 POLICY = (

@@ -124,3 +124,18 @@ def test_a_body_whose_colliders_were_all_cut_away_gets_its_inertial_from_what_it
     point = _body_inertial([], [flat], cfg, stats)  # no volume: a point mass at what it shows
     assert stats["bodies_without_colliders"] == 2 and point.mass == cfg.min_mass_kg
     assert np.allclose(point.com, (1 / 3, 1 / 3, 0))
+
+
+def test_rpy_at_gimbal_lock_gives_the_rotation_without_a_warning() -> None:
+    import warnings
+
+    from scipy.spatial.transform import Rotation
+
+    from react3d_core.export.inertia import rpy_of
+
+    R = Rotation.from_euler("xyz", [0.3, np.pi / 2, 0.7]).as_matrix()  # a box standing on end: pitch 90 deg
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rpy = rpy_of(R)
+    assert rpy[1] == pytest.approx(np.pi / 2) and rpy[2] == 0.0  # roll and yaw share one axis: yaw set to 0
+    assert np.allclose(Rotation.from_euler("xyz", rpy).as_matrix(), R, atol=1e-12)
