@@ -190,7 +190,7 @@ def run_bench(entries: list[dict[str, Any]], out_dir: Path, config: dict[str, An
 
 
 def print_table(result: dict[str, Any]) -> None:
-    from rich.console import Console
+    from flows.commands._console import wide_console
     from rich.table import Table
 
     def f(v: Any, pct: bool = False) -> str:
@@ -206,11 +206,11 @@ def print_table(result: dict[str, Any]) -> None:
         t.add_row(name, f(s.get("n_gt")), f(s.get("n_pred")), f(s.get("frames")), f(s.get("faces")), f(s.get("wall_s")),
                   f(s.get("peak_rss_mb")), f(a.get("f1")), f(b.get("f1")), f(a.get("joint_acc"), True), f(a.get("md")),
                   f(a.get("oe")), f(a.get("mod"), True))
-    Console().print(t)
+    wide_console().print(t)
     mc = result.get("miss_causes")
     if mc:
         for kind, title in (("miss", "missed or IoU < 0.5"), ("joint", "joint errors")):
             top = sorted(((n, k) for k, n in mc[kind].items() if n), reverse=True)
-            Console().print(f"causes, {title}: " + (", ".join(f"{k} {n}" for n, k in top) if top else "none"))
+            wide_console().print(f"causes, {title}: " + (", ".join(f"{k} {n}" for n, k in top) if top else "none"))
     for fl in result.get("failed", []):
-        Console().print(f"[red]failed[/red] {fl['scene']}: {fl['error']}")
+        wide_console().print(f"[red]failed[/red] {fl['scene']}: {fl['error']}")

@@ -40,11 +40,11 @@ def run_store(args: argparse.Namespace) -> int:
     """``cache info|clean --store``: the store's entries by what references them (tasks/store_clean.py)."""
     import time
 
-    from rich.console import Console
+    from flows.commands._console import wide_console
 
     from tasks import store_clean
 
-    console = Console()
+    console = wide_console()
     plan = store_clean.plan_clean(args.older_than, grace_s=max(args.grace, 0.0) * 60)
     gone = sum(e.size for e in plan.remove)
     if args.action == "clean":
@@ -69,11 +69,11 @@ def run(args: argparse.Namespace) -> int:
     import shutil
     import time
 
-    from rich.console import Console
+    from flows.commands._console import wide_console
 
     if args.store:
         return run_store(args)
-    console = Console()
+    console = wide_console()
     cutoff = time.time() - args.older_than * 86400 if args.older_than is not None else None
     for root in _roots():
         if not root.exists():

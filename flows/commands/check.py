@@ -24,6 +24,7 @@ def run(args: argparse.Namespace) -> int:
 
     from rich.console import Console
 
+    from flows.commands._console import wide_console
     from react3d_core.atomic import is_react3d_output
     from react3d_core.config import PipelineConfig
     from react3d_core.config.physics import ENGINES
@@ -45,8 +46,7 @@ def run(args: argparse.Namespace) -> int:
     err = Console(stderr=True)
     with err.status("physics check") as status:
         check = check_output(root, cfg, engines, progress=lambda e, what: status.update(f"{e}: {what}"))
-    console = Console()
-    render(check, console if console.is_terminal else Console(width=200))  # a log or pipe keeps whole names
+    render(check, wide_console())
     write_check(check, target)
     print(f"json: {target}")
     return 1 if args.strict and not check.passed else 0

@@ -26,7 +26,7 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace, scene: str) -> int:
-    from rich.console import Console
+    from flows.commands._console import wide_console
 
     from ._runconfig import pipeline_overrides, precheck_scene, run_with_progress
     from .summary import print_summary
@@ -35,7 +35,7 @@ def _run(args: argparse.Namespace, scene: str) -> int:
 
     cfg = pipeline_overrides(args)
     check_output_dir(args.out, (scene,), kind="scene")  # before Prefect starts: one line, nothing touched
-    console = Console()
+    console = wide_console()
     console.print(precheck_scene(scene, cfg), markup=False, highlight=False)  # "kept N of M frames: why"
     manifest = run_with_progress(scene, args.out, cfg, f"converting {args.scene}")
     print_summary(console, manifest)

@@ -44,7 +44,7 @@ def _seconds(text: str) -> float:
 def run(args: argparse.Namespace) -> int:
     from pathlib import Path
 
-    from rich.console import Console
+    from flows.commands._console import wide_console
     from rich.table import Table
 
     from tasks import prefect_env
@@ -68,7 +68,7 @@ def run(args: argparse.Namespace) -> int:
     from tasks import storage
 
     storage.ensure_result_block()  # REACT3D_STORE=s3://...: result records beside the store (no-op otherwise)
-    console = Console()
+    console = wide_console()
     from ._runconfig import log_path, prefect_errors_to_log
 
     # a failed scene is one row of the table below; Prefect's tracebacks for it go to the log file

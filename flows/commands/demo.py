@@ -17,7 +17,7 @@ def run(args: argparse.Namespace) -> int:
     import json
     from pathlib import Path
 
-    from rich.console import Console
+    from flows.commands._console import wide_console
 
     from react3d_core.synthetic import demo_scene
 
@@ -26,7 +26,7 @@ def run(args: argparse.Namespace) -> int:
 
     from react3d_core.atomic import check_output_dir
 
-    console = Console()
+    console = wide_console()
     out = Path(args.out)
     scene = out / "scene"
     if not (scene / "synth_meta.json").exists():

@@ -51,7 +51,7 @@ def summarize(scene_dir: str, sample: int = 5) -> tuple[list[tuple[str, str]], l
 
 
 def run(args: argparse.Namespace) -> int:
-    from rich.console import Console
+    from flows.commands._console import wide_console
     from rich.table import Table
 
     rows, problems = summarize(args.scene, args.sample)
@@ -60,5 +60,5 @@ def run(args: argparse.Namespace) -> int:
     table.add_column("value")
     for k, v in rows:
         table.add_row(k, v)
-    Console().print(table)
+    wide_console().print(table)
     return 1 if problems else 0

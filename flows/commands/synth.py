@@ -52,7 +52,7 @@ def run(args: argparse.Namespace) -> int:
     import time
     from pathlib import Path
 
-    from rich.console import Console
+    from flows.commands._console import wide_console
 
     from react3d_core.synthetic import generate_scene
 
@@ -67,7 +67,7 @@ def run(args: argparse.Namespace) -> int:
     if not (args.scale > 0 and args.scale < float("inf")):
         raise ConfigError(f"--scale must be a positive number, got {args.scale}")
     check_output_dir(args.out, (args.urdf,) if args.urdf else (), kind="synth")  # never replace the user's files
-    console = Console()
+    console = wide_console()
     t0 = time.perf_counter()
     with console.status(f"rendering {args.frames} frames ({args.source}, seed {args.seed})"):
         out = generate_scene(args.out, source=args.source, seed=args.seed, n_frames=args.frames,
