@@ -160,7 +160,10 @@ def estimate_cavity(pf: PartFrame, cast: callable, bounds: np.ndarray, frame: Fr
     if not np.isfinite(d) or d <= 0.02:
         return cfg.default_depth_m, "default", terms
     if d > cfg.max_depth_m:
-        return cfg.max_depth_m, "max", terms
+        # the nearest bound lies past any furniture's depth: the rays left the part's own body (its back
+        # was never scanned) and met the room wall or a unit across the room, which bound nothing; a
+        # carcass that deep stood in the room in front of that unit and jammed its doors
+        return cfg.default_depth_m, "beyond_max", terms
     return float(d), src, terms
 
 

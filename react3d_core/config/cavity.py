@@ -13,7 +13,7 @@ class CavityConfig(StageConfig):
     wall_factor: float = Field(0.03, gt=0, description="Wall thickness = factor x shortest front edge.")
     min_wall_m: float = Field(0.008, gt=0, description="Minimum wall thickness (m).")
     default_depth_m: float = Field(0.5, gt=0, description="Depth used when no bound is available.")
-    max_depth_m: float = Field(1.2, gt=0, description="Upper clamp on cavity depth.")
+    max_depth_m: float = Field(1.2, gt=0, description="A bound farther than this is none (the rays left the part's body, its back never scanned, and met the room wall or a unit across the room): the cavity takes default_depth_m (source 'beyond_max'). Clamped to it before, a drawer's carcass reached across the room into the swing of the doors facing it.")
     body_step_m: float = Field(0.02, gt=0, description="d_body: depth step of the up-ray profile behind the front (at most prismatic_margin_m keeps travel inside the body).")
     body_jump_m: float = Field(0.15, gt=0, description="d_body: an up-ray this much farther than inside the carcass (or missing) is past the furniture's back.")
     body_lateral_factor: float = Field(0.3, ge=0, le=0.5, description="d_body: up-rays at 0 and +-factor x the front's width from its centre (median).")

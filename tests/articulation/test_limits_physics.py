@@ -64,7 +64,8 @@ def test_body_of_a_tall_unit_whose_top_no_camera_saw_is_found_by_its_side_panels
 
 def test_side_panels_of_the_neighbours_are_not_the_parts_body() -> None:
     """A drawer inside a run: the nearest panels sideways stand 0.9 m away (beyond half its width + 10 cm),
-    so nothing measures the body; the drawer then travels at most prismatic_max_m, not 1.18 m."""
+    so nothing measures the body, and the hit on the room wall 2.6 m away bounds nothing: the drawer travels
+    inside the default carcass, not 1.18 m."""
     m = MeshBuilder(edge=0.1)
     m.add_box([-0.6 - T, 0, 0], [-0.6, 0.37, 2.1], GREY)
     m.add_box([1.2, 0, 0], [1.2 + T, 0.37, 2.1], GREY)
@@ -73,10 +74,12 @@ def test_side_panels_of_the_neighbours_are_not_the_parts_body() -> None:
     geo, pf, cfg = _Geometry(mesh), _drawer_frame(), CavityConfig()
     assert d_body(pf, geo.cast, cfg) == np.inf
     d, src, terms = estimate_cavity(pf, geo.cast, mesh.bounds(), None, None, cfg)
-    assert src == "max" and d == pytest.approx(1.2)  # the ray flies to the room wall 2.6 m away
+    # the ray flies to the room wall 2.6 m away, past max_depth_m (1.2): no bound, the default depth
+    assert terms["hit"] > cfg.max_depth_m and src == "beyond_max" and d == pytest.approx(cfg.default_depth_m)
     a = Articulation(joint_type="prismatic", axis=(0.0, 1.0, 0.0), origin=(0.3, -0.011, 0.4))
     lim = set_limits(a, _grid((0.05, 0.55), -0.011, (0.32, 0.48)), pf.n, d, None, LimitConfig(), body_depth=terms["body"])
-    assert lim.upper == pytest.approx(0.6) and lim.limit_source == "prior"
+    # travel inside the 0.5 m default carcass: 0.5 - prismatic_margin_m (0.02)
+    assert lim.upper == pytest.approx(0.48) and lim.limit_source == "cavity"
 
 
 @pytest.mark.parametrize(("cavity", "body", "upper", "source"), [
