@@ -530,6 +530,18 @@ class PortholeConfig(StageConfig):
     bar_cuts: bool = Field(True, description="No cell cut runs through a porthole door's core (the lines holding at least half of its widest line: |offset| <= 0.87 of the radius): its glass bowl is a hole in the plate's coverage, and the splitter took the hole's side for the corner of an L-shaped outline and cut the plate, and the detergent drawer above the door, in two (off: portholes are found after the split and only replace the cells they cover).")
 
 
+class AgreementConfig(StageConfig):
+    """Fronts the views agree on (perception/heuristic/view_agreement.py): the fronts are found again on
+    interleaved subsets of the frames, and a front no subset finds again is dropped."""
+
+    subsets: int = Field(0, ge=0, description="Opt-in (0: off; measured at 3). The selected frames are dealt into this many interleaved subsets (every n-th frame from each offset) and the fronts found again on each; a front that fewer than min_runs subsets hold (min_iou) came from one mixture of views (a blob only some views paint, a cut one occluder's edge made), not from the scan. RedKitchen, 100k-face copy: 8 / 2 -> 8 / 1 found / false; costs a perception pass per subset on a third of the frames.")
+    min_iou: float = Field(0.3, ge=0, le=1, description="A subset holds a front when one of its fronts overlaps it at this rectangle IoU (on the same plane: facing alike within plane_cos, centres within plane_gap along the normal); a true front found again on fewer views is cut a little differently (RedKitchen's fronts: 0.42-0.99 in at least one subset), an artefact is not found at all (0.00-0.15).")
+    min_runs: int = Field(1, ge=1, description="... a front is kept when at least this many subsets hold it.")
+    min_frames: int = Field(10, ge=1, description="Each subset holds at least this many frames, else there is no agreement test (too few views to find a front on).")
+    plane_cos: float = Field(0.94, ge=0, le=1, description="Two fronts lie on one plane when their normals' dot product is at least this (about 20 degrees) ...")
+    plane_gap: float = Field(0.05, ge=0, description="... and their centres lie within this along the normal (m).")
+
+
 class HeuristicConfig(StageConfig):
     """The weight-free heuristic: planar facets and fronts on the scan mesh, per-frame renders, and the
     image path (fronts found in the colour frames: seams, handles) and sliding-door pairs."""
@@ -555,6 +567,7 @@ class HeuristicConfig(StageConfig):
     cells: CellConfig = Field(default_factory=CellConfig, description="Image path: cells and which become fronts.")
     portholes: PortholeConfig = Field(default_factory=PortholeConfig, description="Image path: round doors from a ring standing proud of a plane.")
     clutter: ClutterConfig = Field(default_factory=ClutterConfig, description="Image path: cluttered cells are no fronts.")
+    agreement: AgreementConfig = Field(default_factory=AgreementConfig, description="Fronts found again on subsets of the frames (opt-in).")
 
     @model_validator(mode="before")
     @classmethod

@@ -31,6 +31,7 @@ from .reach import drawers_within_reach
 from .room_walls import keep_room_doors
 from .sliding import mark_sliding
 from .splashback import on_worktop
+from .view_agreement import agreement, interleaved_subsets, kept_by_agreement
 
 log = logging.getLogger("react3d.perception")
 
@@ -96,10 +97,32 @@ class HeuristicModel:
             self.fronts = keep_room_doors(self.fronts, self.mesh, h.room_wall, rules, h.floor, self.facets.labels)
         if h.reach.drawer_max_top > 0 and self.fronts:  # drawers are within reach
             self.fronts = drawers_within_reach(self.fronts, floor_level(self.mesh, h.floor), h.reach.drawer_max_top)
+        self.agreement: list[int] | None = None  # per front: how many frame subsets found it again
+        self.subset_fronts: list[list[Front]] | None = None  # the fronts each subset found
+        if h.agreement.subsets >= 2 and self.fronts:
+            self.subset_fronts = self._subset_runs(line_detector)
+            if self.subset_fronts is not None:
+                counts = agreement(self.fronts, self.subset_fronts, h.agreement.min_iou, h.agreement.plane_cos,
+                                   h.agreement.plane_gap)
+                self.fronts, self.agreement = kept_by_agreement(self.fronts, counts, h.agreement.min_runs)
         mark_sliding(self.fronts, h.sliding)  # two fronts a track apart: sliding doors
         self.face_front = np.full(self.mesh.n_faces + 1, -1, np.int32)  # last slot: background (-1 ids)
         for i, fr in enumerate(self.fronts):
             self.face_front[fr.faces] = i
+
+    def _subset_runs(self, line_detector: Callable[[np.ndarray], np.ndarray] | None) -> list[list[Front]] | None:
+        """The fronts found on each interleaved subset of the frames (``agreement.subsets``); None when a
+        subset would hold fewer than ``agreement.min_frames`` frames."""
+        ag = self.config.agreement
+        frames = self.scene.frames
+        if len(frames) < ag.subsets * ag.min_frames:
+            log.info("heuristic: %d frames, too few for %d subsets of %d; no agreement test", len(frames),
+                     ag.subsets, ag.min_frames)
+            return None
+        sub_cfg = self.config.model_copy(update={"agreement": ag.model_copy(update={"subsets": 0})})
+        return [HeuristicModel(self.scene.model_copy(update={"frames": tuple(frames[i] for i in idx)}), sub_cfg,
+                               line_detector).fronts
+                for idx in interleaved_subsets(len(frames), ag.subsets)]
 
     def _has_colour(self) -> bool:
         """True when the first frame's colour image reads as a 3-channel image; otherwise one warning
