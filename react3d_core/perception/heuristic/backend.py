@@ -63,15 +63,19 @@ class HeuristicModel:
     to use when ``lines.enabled`` (default: the one the section names, loaded here)."""
 
     def __init__(self, scene: SceneInput, config: HeuristicConfig | None = None,
-                 line_detector: Callable[[np.ndarray], np.ndarray] | None = None) -> None:
+                 line_detector: Callable[[np.ndarray], np.ndarray] | None = None, *,
+                 shared: HeuristicModel | None = None) -> None:
         h = config if config is not None else HeuristicConfig()
         rules = h.fronts
         self.config = h
         self.scene = scene
-        self.mesh: TriMesh = load_mesh(scene.mesh_path)
-        self.raster = Rasterizer(self.mesh)
+        # a model of the same scan mesh and facet rules (run again on a subset of the frames) lends its mesh,
+        # rasteriser and facets: none of them depends on the frames
+        same = shared is not None and shared.scene.mesh_path == scene.mesh_path and shared.config.facets == h.facets
+        self.mesh: TriMesh = shared.mesh if same else load_mesh(scene.mesh_path)
+        self.raster = shared.raster if same else Rasterizer(self.mesh)
         self.scale = h.render.scale
-        self.facets = planar_facets(self.mesh, h.facets)
+        self.facets = shared.facets if same else planar_facets(self.mesh, h.facets)
         self._cache: OrderedDict[str, tuple[np.ndarray, np.ndarray]] = OrderedDict()
         visible, glimpsed, view_dirs = self._visible_facets(h.probe.frames)
         cams = np.array([f.c2w[:3, 3] for f in scene.frames])
@@ -121,7 +125,7 @@ class HeuristicModel:
             return None
         sub_cfg = self.config.model_copy(update={"agreement": ag.model_copy(update={"subsets": 0})})
         return [HeuristicModel(self.scene.model_copy(update={"frames": tuple(frames[i] for i in idx)}), sub_cfg,
-                               line_detector).fronts
+                               line_detector, shared=self).fronts
                 for idx in interleaved_subsets(len(frames), ag.subsets)]
 
     def _has_colour(self) -> bool:
