@@ -29,13 +29,15 @@ def test_a_log_gets_the_whole_table(monkeypatch: pytest.MonkeyPatch) -> None:
     assert "scene-synthesizer_any_7001_tsdf" in text and "11.123" in text and "…" not in text
 
 
-def test_columns_set_by_the_user_win(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("COLUMNS", "90")
+def test_an_exported_80_columns_does_not_narrow_a_log(monkeypatch: pytest.MonkeyPatch) -> None:
+    # CI shells and pytest-xdist workers export COLUMNS=80 while writing to a log
+    monkeypatch.setenv("COLUMNS", "80")
     out = io.StringIO()
     c = wide_console(file=out)
-    assert c.width == 90
-    # rich's own fallback is what the helper replaces: 80 columns cut the cells
-    monkeypatch.delenv("COLUMNS")
+    assert c.width == LOG_WIDTH
+    c.print(_table())
+    assert "…" not in out.getvalue()
+    # rich's own console is what the helper replaces: 80 columns cut the cells
     from rich.console import Console
 
     narrow = io.StringIO()
