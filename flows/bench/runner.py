@@ -206,11 +206,12 @@ def print_table(result: dict[str, Any]) -> None:
         t.add_row(name, f(s.get("n_gt")), f(s.get("n_pred")), f(s.get("frames")), f(s.get("faces")), f(s.get("wall_s")),
                   f(s.get("peak_rss_mb")), f(a.get("f1")), f(b.get("f1")), f(a.get("joint_acc"), True), f(a.get("md")),
                   f(a.get("oe")), f(a.get("mod"), True))
-    wide_console().print(t)
+    console = wide_console()
+    console.print(t)
     mc = result.get("miss_causes")
     if mc:
         for kind, title in (("miss", "missed or IoU < 0.5"), ("joint", "joint errors")):
             top = sorted(((n, k) for k, n in mc[kind].items() if n), reverse=True)
-            wide_console().print(f"causes, {title}: " + (", ".join(f"{k} {n}" for n, k in top) if top else "none"))
+            console.print(f"causes, {title}: " + (", ".join(f"{k} {n}" for n, k in top) if top else "none"))
     for fl in result.get("failed", []):
-        wide_console().print(f"[red]failed[/red] {fl['scene']}: {fl['error']}")
+        console.print(f"[red]failed[/red] {fl['scene']}: {fl['error']}")
