@@ -3,8 +3,9 @@
 One asset folder per scene (``export/assets/<link>/``): textured visuals (OBJ+MTL+texture per
 folder, optional GLB) and convex collision OBJs. URDF, MJCF and USD reference these files with
 relative paths (``../assets/...`` from their own folders), so a 490k-face background is written
-once instead of once per format, and the export can be moved as a whole. Vertices are in
-link-local coordinates (world minus the link origin).
+once instead of once per format, and the export can be moved as a whole. Visual vertices are in
+link-local coordinates (world minus the link origin); a convex collision file is centred on its own
+box centre (``ConvexPiece.centre``), which the URDF places with the collision's origin.
 """
 
 from __future__ import annotations
@@ -72,12 +73,12 @@ def write_link_assets(model: SceneModel, folder: Path, config: ExportConfig | No
                 write_glb(tm, d / f"visual_{k}.glb", offset=link.frame)
         if collisions:
             for k, piece in enumerate(link.collisions):
-                p = write_plain_obj(d / f"collision_{k}.obj", piece.vertices - link.frame, piece.faces)
+                p = write_plain_obj(d / f"collision_{k}.obj", piece.vertices - piece.centre, piece.faces)
                 files.collisions.append(p.relative_to(folder).as_posix())
             for k, piece in enumerate(link.patches):
                 if piece.box is not None:
                     continue  # written as a box primitive
-                p = write_plain_obj(d / "patches" / f"patch_{k}.obj", piece.vertices - link.frame, piece.faces)
+                p = write_plain_obj(d / "patches" / f"patch_{k}.obj", piece.vertices - piece.centre, piece.faces)
                 files.patches.append(p.relative_to(folder).as_posix())
         out[link.name] = files
     return out

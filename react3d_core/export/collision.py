@@ -50,6 +50,15 @@ class ConvexPiece:
         n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
         return unique_axes(n[np.linalg.norm(n, axis=1) > 1e-12], tol=1e-5)
 
+    @cached_property
+    def centre(self) -> np.ndarray:
+        """Centre of its bounding box: writers store the vertices relative to it and place the file there.
+
+        Why: PhysX (SAPIEN, Isaac Sim) cooks a convex mesh in the coordinates of its file; a hull of a few
+        mm whose vertices lie metres from that origin got contacts 1-2 cm deep with a neighbour 4 mm away
+        (a flap blew up in SAPIEN only). Near its own origin the same hull collides exactly."""
+        return (self.vertices.min(0) + self.vertices.max(0)) / 2
+
     def box_frame(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(centre, rotation, extents) of a box piece (writers emit it as a box primitive)."""
         assert self.box is not None
@@ -118,7 +127,9 @@ def convex_pieces(mesh: TriMesh, max_pieces: int = 16, min_thickness: float = 0.
     budget = max_pieces - len(extra)
     for i, comp in enumerate(comps):
         left = budget - len(pieces) - (len(comps) - i - 1)
-        if comp.is_watertight and comp.volume > 0:
+        with np.errstate(invalid="ignore", divide="ignore"):  # a closed but flat component: volume 0, centre 0 / 0
+            solid = comp.is_watertight and comp.volume > 0
+        if solid:
             hull_vol = comp.convex_hull.volume
             if comp.volume >= (1 - convex_tol) * hull_vol or left <= 1:
                 pieces.append(convex_piece(comp.vertices, min_thickness, "component"))

@@ -86,8 +86,9 @@ def urdf_text(model: SceneModel, files: dict[str, LinkFiles], config: ExportConf
                 "    </visual>",
             ]
         meshes = iter(f.patches)
-        cols = [_box(p, link.frame) if p.box is not None else ("0 0 0", "0 0 0", f'<mesh filename="{prefix}{next(meshes)}"/>') for p in link.patches]
-        cols += [("0 0 0", "0 0 0", f'<mesh filename="{prefix}{col}"/>') for col in f.collisions]
+        cols = [_box(p, link.frame) if p.box is not None else (_v(p.centre - link.frame), "0 0 0", f'<mesh filename="{prefix}{next(meshes)}"/>')
+                for p in link.patches]
+        cols += [(_v(p.centre - link.frame), "0 0 0", f'<mesh filename="{prefix}{col}"/>') for p, col in zip(link.collisions, f.collisions, strict=True)]
         for k, (xyz, rpy, geometry) in enumerate(cols):
             out += [
                 f'    <collision name="{link.name}_collision_{k}">',

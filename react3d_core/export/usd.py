@@ -124,10 +124,12 @@ def _visuals(stage, prim_path: str, link: Link, files: LinkFiles, face_sets: lis
 
 
 def _colliders(stage, prim_path: str, pieces: list[ConvexPiece], frame: np.ndarray) -> None:  # noqa: ANN001
-    from pxr import UsdGeom, UsdPhysics
+    from pxr import Gf, UsdGeom, UsdPhysics
 
     for k, piece in enumerate(pieces):
-        mesh = _define_mesh(stage, f"{prim_path}/collisions/piece_{k}", piece.vertices - frame, piece.faces)
+        # points around the piece's own centre, the prim moved there (see ConvexPiece.centre)
+        mesh = _define_mesh(stage, f"{prim_path}/collisions/piece_{k}", piece.vertices - piece.centre, piece.faces)
+        mesh.AddTranslateOp().Set(Gf.Vec3d(*map(float, piece.centre - frame)))
         mesh.CreatePurposeAttr(UsdGeom.Tokens.guide)
         UsdPhysics.CollisionAPI.Apply(mesh.GetPrim())
         UsdPhysics.MeshCollisionAPI.Apply(mesh.GetPrim()).CreateApproximationAttr(UsdPhysics.Tokens.convexHull)

@@ -105,3 +105,31 @@ def test_usd_visuals_keep_scan_topology_with_face_varying_uvs(exported: dict[str
     assert len(tri) == scan.n_faces
     # same triangles as the scan (as point sets)
     np.testing.assert_allclose(np.sort(tri.sum(1), axis=0), np.sort(scan.vertices[scan.faces].sum(1), axis=0), atol=1e-5)
+
+
+def test_usd_convex_colliders_sit_on_their_own_centre_and_in_place(exported: dict[str, Path]) -> None:
+    """Each convex collider's points are centred on 0 and its prim is moved into place (PhysX cooks a hull
+    in its own coordinates and loses a small one far from its origin); in the world, the drawer's pieces
+    span its front and box."""
+    from pxr import Usd, UsdGeom
+
+    from react3d_core.data import load_mesh
+
+    stage = Usd.Stage.Open(str(exported["usd"]))
+    pieces = [p for p in stage.Traverse() if "/collisions/piece_" in str(p.GetPath())]
+    assert pieces
+    drawer: list[np.ndarray] = []
+    for prim in pieces:
+        points = np.asarray(UsdGeom.Mesh(prim).GetPointsAttr().Get(), float)
+        np.testing.assert_allclose((points.min(0) + points.max(0)) / 2, 0, atol=1e-6)
+        if str(prim.GetPath()).startswith("/World/drawer/drawer/"):
+            M = np.asarray(UsdGeom.Xformable(prim).ComputeLocalToWorldTransform(Usd.TimeCode.Default()))
+            drawer.append(points @ M[:3, :3] + M[3, :3])  # USD matrices act on row vectors
+    scene = InteractiveScene.load(exported["usd"].parents[2] / "scene.json")
+    obj = next(o for o in scene.objects if o.object_id == "drawer")
+    root = exported["usd"].parents[2]
+    verts = np.concatenate([load_mesh(root / rel).vertices for rel in (obj.part_mesh, obj.inner_mesh) if rel])
+    world = np.concatenate(drawer)
+    lo, hi = verts.min(0), verts.max(0)
+    assert np.all(world.min(0) >= lo - 0.006) and np.all(world.max(0) <= hi + 0.006)
+    assert np.all(world.min(0) <= lo + 0.01) and np.all(world.max(0) >= hi - 0.01)
