@@ -191,3 +191,38 @@ def test_a_cavity_probe_resting_on_its_own_floor_has_fallen(clean_out: Path) -> 
     assert res.passed and {t.body for t in res.touched} <= {sim.joints[i].link, f"{sim.joints[i].link}_base"}, res
     plan = cavity_probe(f, cfg.probe_radius_m, drop=cfg.cavity_drop_m)
     assert not fell_enough(plan.box, plan.spawn, np.array(res.end), plan.radius)
+
+
+def test_sapien_joints_take_the_urdfs_friction(clean_out: Path, tmp_path: Path) -> None:
+    """SAPIEN's builder reads <dynamics friction> but never applies it (every joint kept PhysX's 0.05); the
+    check applies the file's value. Written 0 it drives freely; a door written with friction 1 resists the
+    check's drive and stops further from its limit, so the value reaches PhysX."""
+    pytest.importorskip("sapien")
+    import re
+    import shutil
+
+    from react3d_core.physics.check import _make
+
+    out = tmp_path / "out"
+    shutil.copytree(clean_out, out)
+    urdf = out / "export" / "urdf" / "scene.urdf"
+    sim = _make("sapien", urdf, PhysicsConfig())
+    try:
+        assert {j.name: float(j.friction) for _, j in sim.active} == {"door_joint": 0.0, "drawer_joint": 0.0}
+    finally:
+        sim.close()
+    text = urdf.read_text()
+    door = re.search(r'<joint name="door_joint".*?</joint>', text, re.S)
+    assert door is not None
+    urdf.write_text(text.replace(door.group(0), re.sub(r'friction="0"', 'friction="1"', door.group(0))))
+    sim = _make("sapien", urdf, PhysicsConfig())
+    try:
+        assert {j.name: round(float(j.friction), 6) for _, j in sim.active} == {"door_joint": 1.0, "drawer_joint": 0.0}
+    finally:
+        sim.close()
+    e = check_output(out, PhysicsConfig(probes=False), ("sapien",)).engines[0]
+    joints = {j.joint: j for j in e.joints}
+    assert joints["drawer_joint"].passed
+    free = by_object(run(clean_out, "sapien"))["door"]
+    assert free.passed and free.reached > 0.99
+    assert joints["door_joint"].reached < free.reached - 0.02, (joints["door_joint"].reached, free.reached)
