@@ -120,6 +120,10 @@ class SplashbackConfig(StageConfig):
     cover: float = Field(0.2, ge=0, le=1, description="Share of that strip the worktop must cover.")
     min_up: float = Field(0.7, ge=0, le=1, description="Worktop faces: the normal's z is above this (a scanned worktop is noisy and cluttered: its faces tilt).")
     run_depth: tuple[float, float] = Field((0.45, 0.8), description="A front also stands on a worktop when another front, this far in front of it (m, from/to: a worktop's depth; a microwave's door is nearer the run's front line), overlaps it across with its top edge within band of the front's bottom: the run under a worktop the mesh lacks (black granite returns no depth). (0, 0): off.")
+    wall_ring: float = Field(0.3, ge=0, description="A front is kept when the wall stands behind it (an appliance on the worktop, pushed back): surface in a ring this wide (m) around its sides and top ... (0: no such test)")
+    wall_behind: tuple[float, float] = Field((0.2, 1.0), description="... lying this far behind its plane (m, from/to), facing the same way ...")
+    wall_share: float = Field(0.1, ge=0, le=1, description="... covers at least this share of the ring.")
+    worktop_rise: float = Field(0.07, ge=0, description="For that run: the front's bottom edge may also lie up to band + this (m) above the run's top edge (the worktop's thickness and the gap between it and the run's fronts).")
 
 
 class RoomWallConfig(StageConfig):

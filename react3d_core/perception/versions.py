@@ -103,6 +103,8 @@ name them without importing the backends (Open3D, OpenCV)."""
 #     are splash-back (splashback.run_depth)
 # (opt-in, off it changes nothing: the faces no offset peak took vote again, planes.residual_dip: a front set back
 # a few cm beside a larger one, a microwave on its cabinet)
-HEURISTIC_VERSION = "51"
+# 52: splash-back allows for the worktop's thickness above a run (splashback.worktop_rise), and a front with the
+#     wall behind it (an appliance pushed back on the worktop) is no splash-back (splashback.wall_*)
+HEURISTIC_VERSION = "52"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -7,7 +7,7 @@ import numpy as np
 from react3d_core.config.heuristic import SplashbackConfig
 from react3d_core.data.mesh import TriMesh
 from react3d_core.perception.heuristic.fronts import Front
-from react3d_core.perception.heuristic.splashback import on_worktop
+from react3d_core.perception.heuristic.splashback import on_worktop, wall_behind_share
 
 
 def _quad(x0: float, x1: float, y0: float, y1: float, z0: float, z1: float) -> tuple[np.ndarray, np.ndarray]:
@@ -85,3 +85,50 @@ def test_run_below_stands_for_a_worktop_the_mesh_lacks() -> None:
     assert SplashbackConfig().run_depth == (0.45, 0.8)
     assert on_worktop(fronts, mesh, SplashbackConfig()) == [False, True, False, False, False]
     assert on_worktop(fronts, mesh, SplashbackConfig(run_depth=(0.0, 0.0))) == [False] * 5
+
+
+def test_run_below_allows_for_the_worktops_thickness() -> None:
+    """The panel's bottom lies above the run's top edge by the worktop's thickness and the gap under it. Door top
+    0.88 m; ``band`` 0.08, ``worktop_rise`` 0.07: the panel's bottom may lie from 0.80 to 1.03 m (exclusive).
+    - bottom 0.98 (0.10 above the door: a 4 cm worktop on a 6 cm gap): splash-back;
+    - bottom 1.02 (0.14 above): splash-back; bottom 1.05 (0.17 above): kept;
+    - with ``worktop_rise`` 0 the bound is 0.96: the panel at 0.98 is kept."""
+    mesh = _mesh(_quad(-1.0, 4.0, -2.0, 0.6, 0.0, 0.0), _quad(0.0, 4.0, 0.6, 0.6, 0.0, 2.4))
+    door = _front(0.2, 0.8, 0.1, 0.88, y=0.0)
+    fronts = [door, _front(0.3, 0.7, 0.98, 1.3), _front(0.3, 0.7, 1.02, 1.3), _front(0.3, 0.7, 1.05, 1.3)]
+    rules = SplashbackConfig()
+    assert (rules.band, rules.worktop_rise) == (0.08, 0.07)
+    assert on_worktop(fronts, mesh, rules) == [False, True, True, False]
+    assert on_worktop(fronts[:2], mesh, SplashbackConfig(worktop_rise=0.0)) == [False, False]
+
+
+def _grid_wall(x0: float, x1: float, y: float, z0: float, z1: float, step: float = 0.02) -> tuple[np.ndarray, np.ndarray]:
+    """A wall at y = ``y`` facing -y made of ``step`` squares (the ring test reads face centroids)."""
+    xs, zs = np.arange(x0, x1 + 1e-9, step), np.arange(z0, z1 + 1e-9, step)
+    X, Z = np.meshgrid(xs, zs)
+    v = np.stack([X.ravel(), np.full(X.size, y), Z.ravel()], -1)
+    nx = len(xs)
+    i = (np.arange(len(zs) - 1)[:, None] * nx + np.arange(nx - 1)[None, :]).ravel()
+    f = np.concatenate([np.stack([i, i + nx + 1, i + nx], -1), np.stack([i, i + 1, i + nx + 1], -1)])
+    return v, f
+
+
+def test_appliance_pushed_back_on_a_worktop_stands_in_front_of_the_wall() -> None:
+    """A 0.6 m worktop at 0.9 m (y 0..0.6) against a wall at y = 0.6. A microwave pushed back stands on it, its door
+    at y = 0.2 (0.2 m of worktop in front of it, 0.4 m in front of the wall), x 0.5-0.9, 0.92-1.20 m.
+    Its strip 0.03-0.33 m in front holds worktop over y 0-0.17: 0.17 x 0.4 = 0.068 m² of the 0.3 x 0.4 = 0.12 m²
+    strip (57 % >= ``cover`` 20 %), so the worktop test alone takes it for splash-back. Its ring 0.3 m wide round the
+    sides and top is (0.4 + 0.6) x (0.28 + 0.3) - 0.4 x 0.28 = 0.468 m², all of it wall 0.4 m behind the door
+    (within ``wall_behind`` 0.2-1.0): share ~1 >= ``wall_share`` 0.1, kept. A panel flush with the wall over the same
+    worktop has its wall 0 m behind it: share 0, dropped. With ``wall_ring`` 0 the microwave is dropped too."""
+    top = _grid_wall(0.0, 2.0, 0.0, 0.0, 0.6)  # the same grid laid flat: y -> z, z -> y, facing up
+    top = (top[0][:, [0, 2, 1]] + [0.0, 0.0, 0.9], top[1])
+    mesh = _mesh(top, _quad(-1.0, 4.0, -2.0, 0.6, 0.0, 0.0), _grid_wall(-0.5, 2.5, 0.6, 0.0, 2.0))
+    assert mesh.face_normals[0, 2] > 0.99
+    microwave, panel = _front(0.5, 0.9, 0.92, 1.2, y=0.2), _front(1.2, 1.8, 0.92, 1.4, y=0.6)
+    rules = SplashbackConfig()
+    assert (rules.wall_ring, rules.wall_behind, rules.wall_share) == (0.3, (0.2, 1.0), 0.1)
+    assert wall_behind_share(microwave, mesh, rules) > 0.9
+    assert wall_behind_share(panel, mesh, rules) == 0.0
+    assert on_worktop([microwave, panel], mesh, rules) == [False, True]
+    assert on_worktop([microwave, panel], mesh, SplashbackConfig(wall_ring=0.0)) == [True, True]
