@@ -377,6 +377,8 @@ class HandleConfig(StageConfig):
     bar_plane_min: int = Field(2, ge=0, description="On a plane where at least this many handles stand out of the scan (bar_share of their pixels on the surface in front of the plane), colour-only handles are panel bevels and shading lines, not handles (0: off).")
     bar_share: float = Field(0.5, ge=0, le=1, description="... share of a handle's pixels on that surface that makes it a handle in the scan.")
     bar_reach: float = Field(0.0, ge=0, description="With bar_plane_min: only colour-only handles within this distance (m) of a bar go (0: every one on the plane).")
+    bar_row: float = Field(0.0, ge=0, description="With bar_plane_min: a colour-only bar in line with a bar the scan holds (the same way, centre lines within this (m) across: parallax paints a proud bar a few cm off) stays: the next front's handle in the row or column (0: off).")
+    bar_row_gap: float = Field(0.05, ge=0, description="... the two at least this far apart (m) along the line (a bevel or shadow line runs beside its bar, overlapping it).")
     pane_bar_reach: float = Field(0.1, ge=0, description="A glass pane is one door's: of the handles on its frame (their boxes inside the pane's box grown by this much, m; 0: off), colour-only ones go when a bar standing out of the scan (bar_share) is among them. A shaded patch on an oven's glass-door stile, read as a second handle beside its bar, cut the door in two along the pane's edge.")
 
 

@@ -483,6 +483,8 @@ DEFAULTS = {
     "perception.heuristic.handles.knob_panel_gap": 0.16,
     "perception.heuristic.handles.seam_share": 0.9,
     "perception.heuristic.handles.bar_plane_min": 2,
+    "perception.heuristic.handles.bar_row": 0.0,
+    "perception.heuristic.handles.bar_row_gap": 0.05,
     "perception.heuristic.handles.bar_share": 0.5,
     "perception.heuristic.handles.bar_reach": 0.0,
     "perception.heuristic.handles.pane_bar_reach": 0.1,

@@ -261,7 +261,8 @@ def find_handles(o: Orthophoto, coverage: np.ndarray, cfg: HeuristicConfig, diff
             lone += [h for h in out if id(h) not in ids]
         out = kept
     if protrusion is not None and not bars_only:
-        out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share, p.bar_reach / o.res)
+        out = bars_outrank_colour(out, protrusion, p.bar_plane_min, p.bar_share, p.bar_reach / o.res,
+                                  p.bar_row / o.res, p.bar_row_gap / o.res)
     return out
 
 
@@ -348,7 +349,7 @@ def stand_out(handles: Sequence[Handle], bars: np.ndarray, share: float) -> list
 
 
 def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, share: float,
-                        reach_px: float = 0.0) -> list[Handle]:
+                        reach_px: float = 0.0, row_px: float = 0.0, row_gap_px: float = 0.0) -> list[Handle]:
     """``handles`` less the colour-only ones when at least ``min_bars`` of them (0: never) stand out of the
     scan: ``share`` or more of their pixels on ``bars`` (the surface in front of the plane). With
     ``reach_px`` > 0 only a colour-only handle whose box lies within that many pixels of a bar's box goes.
@@ -357,12 +358,18 @@ def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, 
     and the shading along its frame are straight colour lines of a bar's size beside them (a
     scene-synthesizer door's panel edge under its bar, the worktop's shadow along a drawer's top), and
     every one read as a handle cut its door between it and the door's real handle. A handle the views see
-    but the scan does not hold is kept on planes where no handles stand out (a decimated or a real scan)."""
+    but the scan does not hold is kept on planes where no handles stand out (a decimated or a real scan).
+    With ``row_px`` > 0 a colour-only bar in line with a bar the scan holds (``in_line_with``: the next front's
+    handle in the same row or column) stays: a scan holds some bars of a run and loses others (a dark front's
+    pale bars standing over a surface the sensor missed), while a bevel or a shadow line runs beside a bar."""
     if min_bars <= 0:
         return handles
     on_bar = stand_out(handles, bars, share)
     if sum(on_bar) < min_bars:
         return handles
+    if row_px > 0:
+        held = [h for h, b in zip(handles, on_bar) if b]
+        on_bar = [b or in_line_with(h, held, row_px, row_gap_px) for h, b in zip(handles, on_bar)]
     if reach_px <= 0:
         return [h for h, b in zip(handles, on_bar) if b]
     boxes = np.array([h.box for h, b in zip(handles, on_bar) if b], float)
@@ -373,6 +380,25 @@ def bars_outrank_colour(handles: list[Handle], bars: np.ndarray, min_bars: int, 
         return bool((np.hypot(dx, dy) <= reach_px).any())
 
     return [h for h, b in zip(handles, on_bar) if b or not near_bar(h)]
+
+
+def in_line_with(h: Handle, bars: Sequence[Handle], across_px: float, gap_px: float, length_ratio: float = 2.0) -> bool:
+    """Whether bar ``h`` lies in line with one of ``bars``: both bars (no knobs) running the same way, their centre
+    lines within ``across_px`` across, their boxes at least ``gap_px`` apart along the line and neither more than
+    ``length_ratio`` times the other's length: the handles of a row of drawers, of a column of doors."""
+    if h.knob:
+        return False
+    ax = 0 if h.horizontal else 1  # the axis the bar runs along (columns for a horizontal bar)
+    lo, hi = h.box[ax], h.box[ax + 2]
+    mid = 0.5 * (h.box[1 - ax] + h.box[3 - ax])
+    for b in bars:
+        if b.knob or b.horizontal != h.horizontal or b is h:
+            continue
+        blo, bhi = b.box[ax], b.box[ax + 2]
+        if (abs(0.5 * (b.box[1 - ax] + b.box[3 - ax]) - mid) <= across_px and max(blo - hi, lo - bhi) >= gap_px
+                and max(hi - lo, bhi - blo) <= length_ratio * max(min(hi - lo, bhi - blo), 1)):
+            return True
+    return False
 
 
 def _is_knob(w: int, h: int, area: int, res: float, p: HandleConfig) -> bool:

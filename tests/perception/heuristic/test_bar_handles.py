@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from react3d_core.config.heuristic import HeuristicConfig
-from react3d_core.perception.heuristic.front_cells import Handle, bars_outrank_colour, find_handles, split_cells
+from react3d_core.perception.heuristic.front_cells import Handle, bars_outrank_colour, find_handles, in_line_with, split_cells
 from tests.perception.heuristic.flat_orthos import flat_ortho, oven_door_image
 
 
@@ -43,6 +43,28 @@ def test_bars_outrank_colour_only_near_a_bar() -> None:
     assert bars_outrank_colour([a, b, c, d], bars, 2, 0.5, 4.0) == [a, b, d]
     assert bars_outrank_colour([a, b, c, d], bars, 2, 0.5, 3.0) == [a, b, c, d]
     assert bars_outrank_colour([a, b, c, d], bars, 2, 0.5, 0.0) == [a, b]
+
+
+def test_colour_bar_in_line_with_a_scan_bar_stays() -> None:
+    """A row of drawers: scan bars A (cols 0-39, row 20) and B (cols 60-99, row 20); boxes are (c0, r0, c1, r1) with
+    c1, r1 past the last pixel, so a bar's centre row is 20.5. Colour-only C (cols 120-159, rows 22-23: centre 23,
+    2.5 px off, its box 120 - 100 = 20 px from B's along the row), a bevel line D under A (cols 0-39, row 26:
+    centre 26.5, 6 px off, overlapping A along) and E far off the row (cols 120-159, row 40: 20 px off). With ``row_px`` 3 and ``row_gap_px`` 5: C stays (2.5 <= 3, gap 21 >= 5), D goes (it
+    overlaps A and B along: gap < 0; and 5.5 > 3 across), E goes. ``row_px`` 2: C goes as well (2.5 > 2);
+    ``row_px`` 0: the plane-wide rule, every colour-only bar goes. A vertical colour bar in that row does not
+    line up with horizontal bars; nor does a bar more than twice as long (cols 120-219)."""
+    bars = np.zeros((60, 240), bool)
+    a, b = _handle(0, 20, 40, 21), _handle(60, 20, 100, 21)
+    bars[20, 0:100] = True
+    c, d, e = _handle(120, 22, 160, 24), _handle(0, 26, 40, 27), _handle(120, 40, 160, 41)
+    assert bars_outrank_colour([a, b, c, d, e], bars, 2, 0.5, 0.0, 3.0, 5.0) == [a, b, c]
+    assert bars_outrank_colour([a, b, c, d, e], bars, 2, 0.5, 0.0, 2.0, 5.0) == [a, b]
+    assert bars_outrank_colour([a, b, c, d, e], bars, 2, 0.5) == [a, b]
+    upright, long_ = _handle(120, 10, 122, 40), _handle(120, 20, 220, 21)
+    assert not in_line_with(upright, [a, b], 30.0, 5.0)
+    assert not in_line_with(long_, [a, b], 3.0, 5.0)  # 100 px against 40: more than twice as long
+    assert in_line_with(c, [b], 3.0, 20.0) and not in_line_with(c, [b], 3.0, 21.0)  # 20 px from B
+    assert in_line_with(c, [a, b], 3.0, 21.0)  # ... and 120 - 40 = 80 px from A
 
 
 def _two_raised_panel_doors() -> tuple[np.ndarray, np.ndarray]:
