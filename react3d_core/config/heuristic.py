@@ -6,7 +6,7 @@ once, with its description. Renamed keys of the earlier flat layout are rejected
 (``RENAMED``).
 """
 
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import Field, model_validator
 
@@ -315,12 +315,15 @@ class SeamConfig(StageConfig):
 
 
 class LineConfig(StageConfig):
-    """Seams supported by straight line segments that a learned detector (M-LSD) finds in the colour frames,
-    opt-in (perception/heuristic/line_evidence.py; the detector runs in react3d_models/line_segments.py).
+    """Seams supported by straight line segments found in the colour frames (perception/heuristic/line_evidence.py):
+    by OpenCV's LSD (classic_lines.py, no weights; on by default) or by the learned M-LSD (opt-in, weights;
+    react3d_models/line_segments.py).
     Visibility along a segment is judged like the orthophotos' (``ortho.render_scale``, ``ortho.erode_px``,
     ``ortho.edge_jump``, ``ortho.depth_tol``, ``ortho.depth_tol_rel``)."""
 
-    enabled: bool = Field(False, description="Run the line-segment detector on a few views of each plane and let seams that its segments support in several views cut cells (needs the ai-edge-litert package and the M-LSD weights; docs/perception.md).")
+    enabled: bool = Field(True, description="Run the line-segment detector on a few views of each plane and let seams that its segments support in several views cut cells (docs/perception.md).")
+    detector: Literal["lsd", "mlsd"] = Field("lsd", description="lsd: OpenCV's LSD, a classical detector (no weights); mlsd: the learned M-LSD (needs the ai-edge-litert package and its weights, below).")
+    gamma: float = Field(0.5, gt=0, le=1, description="lsd reads the grey image lifted to this power: below 1 it spreads the dark levels, where the seam between two black fronts is a few grey levels deep.")
     weights: str | None = Field(None, description="Path to the M-LSD tflite file (M-LSD_512_tiny_fp16.tflite or M-LSD_512_large_fp16.tflite from github.com/navervision/mlsd, tflite_models/); null: the environment variable REACT3D_MLSD_WEIGHTS.")
     threads: int = Field(2, ge=1, description="CPU threads of the detector.")
     min_score: float = Field(0.1, ge=0, le=1, description="Segment centres scoring below this are dropped (the detector's own threshold).")

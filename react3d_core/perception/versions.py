@@ -105,6 +105,9 @@ name them without importing the backends (Open3D, OpenCV)."""
 # a few cm beside a larger one, a microwave on its cabinet)
 # 52: splash-back allows for the worktop's thickness above a run (splashback.worktop_rise), and a front with the
 #     wall behind it (an appliance pushed back on the worktop) is no splash-back (splashback.wall_*)
-HEURISTIC_VERSION = "52"
+# 53: seams supported by straight segments several views agree on cut cells by default, the segments found by
+#     OpenCV's LSD on the grey image lifted by gamma 0.5 (lines.enabled, lines.detector lsd; no weights)
+# (opt-in, off it changes nothing: a colour-only bar in line with a bar the scan holds stays, handles.bar_row)
+HEURISTIC_VERSION = "53"
 # 2: says "sliding" for GT prismatic joints in the part's front plane
 ORACLE_VERSION = "2"

@@ -108,7 +108,7 @@ def test_enabled_without_weights_is_a_config_error(monkeypatch: pytest.MonkeyPat
 
     monkeypatch.delenv(WEIGHTS_ENV, raising=False)
     with pytest.raises(ConfigError, match="no M-LSD weights are given"):
-        load_line_detector(HeuristicConfig(lines={"enabled": True}).lines)
+        load_line_detector(HeuristicConfig(lines={"enabled": True, "detector": "mlsd"}).lines)
 
 
 @needs_detector
@@ -134,18 +134,6 @@ def test_the_opt_in_path_end_to_end() -> None:
     """The heuristic built from its config with ``lines.enabled`` on a small seamless two-door scene: the
     detector runs on the views it picks, the doors' seam at x = 0.6 m is supported by several of them, and
     the two doors are found."""
-    from tests.perception.heuristic.test_image_fronts import _seamless_cabinet_scene
-    from react3d_core.perception.heuristic.backend import load_line_detector
-    from react3d_core.perception.heuristic.image_fronts import find_image_fronts
-    from react3d_core.raster import Rasterizer
+    from tests.perception.heuristic.test_classic_lines import assert_seam_supported_and_two_doors
 
-    mesh, frames, images = _seamless_cabinet_scene()
-    cfg = HeuristicConfig(lines={"enabled": True, "weights": str(TINY)})
-    res = find_image_fronts(mesh, frames, Rasterizer(mesh), lambda f: images[f.frame_id], cfg,
-                            detect_lines=load_line_detector(cfg.lines))
-    i = min(range(len(res.planes)), key=lambda k: abs(res.planes[k].d))   # the doors' plane (y = 0)
-    o, sup = res.orthophotos[i], res.lines[i]
-    assert sup.n_views >= 3
-    col = int((0.6 * np.sign(o.plane.u[0]) - o.u0) / o.res)
-    assert sup.vert[:, col - 3:col + 4].max() >= cfg.lines.min_views
-    assert len(res.fronts) == 2
+    assert_seam_supported_and_two_doors(HeuristicConfig(lines={"enabled": True, "detector": "mlsd", "weights": str(TINY)}))

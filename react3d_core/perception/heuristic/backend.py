@@ -22,6 +22,7 @@ from ...errors import ConfigError
 from ...raster import Rasterizer
 from ...scene_io.images import frame_rgb
 from .behind_glass import seen_through_glass
+from .classic_lines import lsd_detector
 from .facets import planar_facets
 from .constants import COLOUR_NDIM, RGB
 from .fronts import Front, find_fronts
@@ -47,8 +48,11 @@ LINE_DETECTOR = ("react3d_models.line_segments", "load_line_detector")
 
 
 def load_line_detector(cfg: LineConfig) -> Callable[[np.ndarray], np.ndarray]:
-    """The line-segment detector ``perception.heuristic.lines`` asks for (an RGB image -> segments (N, 4+)),
-    from the weight-backed package; a ConfigError (one line) when it cannot be loaded."""
+    """The line-segment detector ``perception.heuristic.lines`` asks for (an RGB image -> segments (N, 4+)):
+    OpenCV's LSD (``detector: lsd``, no weights) or the learned one from the weight-backed package
+    (``mlsd``); a ConfigError (one line) when that cannot be loaded."""
+    if cfg.detector == "lsd":
+        return lsd_detector(cfg)
     module, attr = LINE_DETECTOR
     try:
         loader = getattr(importlib.import_module(module), attr)

@@ -1,8 +1,8 @@
-"""Seam evidence from straight line segments that a learned detector finds in the colour frames (opt-in).
+"""Seam evidence from straight line segments that a detector finds in the colour frames.
 
-A seam between two fronts is a straight line in every photo that sees it. A line-segment detector (M-LSD,
-run outside the core: react3d_models/line_segments.py) gives, per frame, segments in pixels; they reach
-this module as plain arrays. Each segment is carried onto a plane by ray–plane intersection and kept only
+A seam between two fronts is a straight line in every photo that sees it. A line-segment detector gives, per
+frame, segments in pixels: OpenCV's LSD by default (classic_lines.py, no weights) or the learned M-LSD (run
+outside the core: react3d_models/line_segments.py); they reach this module as plain arrays. Each segment is carried onto a plane by ray–plane intersection and kept only
 where the scan surface seen along the ray is that plane, a few pixels to either side too (the edge of a
 chair in front of a cabinet is not on the cabinet; colour and depth may be misregistered by a few pixels).
 What is left is drawn into the plane's orthophoto grid as vertical or horizontal line evidence, and a grid
